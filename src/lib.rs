@@ -1,0 +1,61 @@
+//! # ringmesh
+//!
+//! Pretension design of the cable mesh of large ring-truss deployable reflector
+//! antennas (Hu, Wang, Yang 2023, "The Pretension Design of Cable Mesh considering
+//! the Large Deformation of Ring Truss").
+//!
+//! The problem: find the force density `q` of every cable so that the front net's
+//! nodes lie on the paraboloid `z = (x² + y²)/(4F)` and the cable tension is as
+//! uniform as possible, for the ring truss as it deforms under the net's pull.
+//!
+//! The pipeline, layer by layer:
+//!
+//! * [`scene`] — the problem file (TOML), validated once into a [`Scene`];
+//! * [`geometry`] — the paraboloid, the ring-truss layout and the net generators,
+//!   which turn a scene into a cable [`Network`];
+//! * [`network`] — nodes, cables, groups, the fixed/free split and the
+//!   interchange JSON format;
+//! * [`fdm`] — the force density method: forward equilibrium, reactions, the
+//!   equilibrium matrix `A(x)` of the inverse form and adjoint sensitivities;
+//! * [`report`] — files a run writes (atomically): JSON, VTK.
+#![warn(missing_docs)]
+
+pub mod fdm;
+pub mod geometry;
+pub mod network;
+pub mod report;
+pub mod run;
+pub mod scene;
+
+pub use fdm::{Equilibrium, FdmError, FdmStructure};
+pub use network::{CableGroup, Network, NetworkError};
+pub use scene::{Scene, SceneError};
+
+/// Every error the library returns, one variant per module.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// An invalid scene file.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// An invalid or inconsistent network.
+    #[error(transparent)]
+    Network(#[from] NetworkError),
+    /// The force density method failed on a valid network.
+    #[error(transparent)]
+    Fdm(#[from] FdmError),
+    /// Reading or writing a file.
+    #[error(transparent)]
+    Report(#[from] report::ReportError),
+}
+
+impl Error {
+    /// True when the error is the user's input (exit code 2), false for I/O and
+    /// internal failures (exit code 1).
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            Error::Scene(_) | Error::Network(_) => true,
+            Error::Fdm(e) => e.is_bad_input(),
+            Error::Report(e) => e.is_bad_input(),
+        }
+    }
+}

@@ -1,0 +1,88 @@
+//! VTK XML unstructured grid (`.vtu`) of a cable network, for ParaView.
+
+use std::fmt::Write;
+
+use crate::network::Network;
+
+/// The network as a `.vtu` document: points, one line cell per cable; point data
+/// `fixed` (0/1); cell data `q_n_per_m`, `group` (index into the network's
+/// distinct group labels, listed in a field-data comment) and, when given,
+/// `force_n`.
+///
+/// `nodes` (n_nodes × 3) overrides the network's positions (an equilibrium
+/// shape, say); `forces_n` is n_edges.
+///
+/// # Panics
+/// If `nodes` or `forces_n` do not match the network's shape.
+#[track_caller]
+pub fn network_vtu(network: &Network, nodes: Option<&[[f64; 3]]>, forces_n: Option<&[f64]>) -> String {
+    let nodes = nodes.unwrap_or(&network.nodes);
+    assert_eq!(nodes.len(), network.n_nodes(), "nodes: one row per node");
+    if let Some(f) = forces_n {
+        assert_eq!(f.len(), network.n_edges(), "forces_n: one entry per edge");
+    }
+    let (n, m) = (network.n_nodes(), network.n_edges());
+    let mut labels: Vec<&str> = Vec::new();
+    let group_ids: Vec<usize> = match &network.groups {
+        Some(groups) => groups
+            .iter()
+            .map(|g| match labels.iter().position(|l| l == g) {
+                Some(i) => i,
+                None => {
+                    labels.push(g);
+                    labels.len() - 1
+                }
+            })
+            .collect(),
+        None => vec![0; m],
+    };
+    let fixed = network.fixed_mask();
+
+    let mut s = String::with_capacity(64 * (n + m) + 1024);
+    s.push_str("<?xml version=\"1.0\"?>\n");
+    s.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n");
+    let _ = writeln!(s, "<!-- groups: {} -->", labels.join(", "));
+    s.push_str("<UnstructuredGrid>\n");
+    let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{m}\">");
+    s.push_str("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for p in nodes {
+        let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
+    }
+    s.push_str("</DataArray>\n</Points>\n<Cells>\n");
+    s.push_str("<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+    for [i, j] in &network.edges {
+        let _ = writeln!(s, "{i} {j}");
+    }
+    s.push_str("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+    for k in 1..=m {
+        let _ = writeln!(s, "{}", 2 * k);
+    }
+    s.push_str("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
+    for _ in 0..m {
+        s.push_str("3\n");
+    }
+    s.push_str("</DataArray>\n</Cells>\n<PointData>\n");
+    s.push_str("<DataArray type=\"UInt8\" Name=\"fixed\" format=\"ascii\">\n");
+    for f in fixed {
+        s.push_str(if f { "1\n" } else { "0\n" });
+    }
+    s.push_str("</DataArray>\n</PointData>\n<CellData>\n");
+    s.push_str("<DataArray type=\"Float64\" Name=\"q_n_per_m\" format=\"ascii\">\n");
+    for q in &network.q {
+        let _ = writeln!(s, "{q:e}");
+    }
+    s.push_str("</DataArray>\n<DataArray type=\"Int32\" Name=\"group\" format=\"ascii\">\n");
+    for g in group_ids {
+        let _ = writeln!(s, "{g}");
+    }
+    s.push_str("</DataArray>\n");
+    if let Some(forces) = forces_n {
+        s.push_str("<DataArray type=\"Float64\" Name=\"force_n\" format=\"ascii\">\n");
+        for f in forces {
+            let _ = writeln!(s, "{f:e}");
+        }
+        s.push_str("</DataArray>\n");
+    }
+    s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    s
+}

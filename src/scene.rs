@@ -1,0 +1,336 @@
+//! The problem file: a reflector scene in TOML, with SI units in every key name.
+//!
+//! [`Scene::read`] parses (unknown keys are rejected) and validates every value
+//! once; an invalid scene is a [`SceneError`] naming the key and the reason.
+//! Geometric checks that need the generated nets (ties of positive length, an
+//! unfolded grid, no degenerate cable) are made by [`crate::geometry::build_mesh`]
+//! with the same error type.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+/// A whole reflector scene: the input of one run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Name of the scene; results go to `results/<name>/`. Defaults to the file stem.
+    #[serde(default)]
+    pub name: String,
+    /// The reflecting surface.
+    pub reflector: Reflector,
+    /// The ring truss that carries the nets.
+    pub truss: Truss,
+    /// The front (reflecting) net.
+    pub front_net: FrontNet,
+    /// The rear net.
+    pub rear_net: RearNet,
+    /// Cable properties (all nets and ties).
+    pub cables: Cables,
+    /// Which physics the model includes (DESIGN §8).
+    #[serde(default)]
+    pub effects: Effects,
+}
+
+/// The paraboloid `z = (x² + y²)/(4F)` and the aperture on it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reflector {
+    /// Diameter of the aperture circle (plan), m.
+    pub aperture_diameter_m: f64,
+    /// Focal length F of the paraboloid, m.
+    pub focal_length_m: f64,
+    /// Distance h from the paraboloid axis to the aperture centre (plan), m;
+    /// 0 for a centre-fed reflector.
+    #[serde(default)]
+    pub offset_m: f64,
+}
+
+/// How the ring truss is supported.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Supports {
+    /// A 3-2-1 statically determinate support: the self-equilibrated net loads
+    /// deform the truss without reactions.
+    #[default]
+    Isostatic,
+}
+
+/// The ring truss (paper §3, Table 3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Truss {
+    /// Number of bays N (= vertical battens = top hinges).
+    pub bays: usize,
+    /// Batten length: vertical distance from bottom to top hinges, m.
+    pub height_m: f64,
+    /// Outer diameter of the tubes, m.
+    pub tube_outer_diameter_m: f64,
+    /// Inner diameter of the tubes, m.
+    pub tube_inner_diameter_m: f64,
+    /// Young's modulus of the tubes, Pa.
+    pub youngs_modulus_pa: f64,
+    /// Shear modulus of the tubes, Pa.
+    pub shear_modulus_pa: f64,
+    /// Density of the tube material, kg/m³.
+    pub density_kg_per_m3: f64,
+    /// The supports.
+    #[serde(default)]
+    pub supports: Supports,
+}
+
+/// The front net: sector subdivision of the N-gon of top hinges.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrontNet {
+    /// Subdivisions of each sector's radial edge (rings of the grid).
+    pub rings: usize,
+    /// Inward sag of the boundary at mid-bay, as a fraction of the bay chord.
+    pub boundary_sag_ratio: f64,
+    /// Target mean tension of the front net's interior cables, N.
+    pub mean_tension_n: f64,
+}
+
+/// The rear net: the front net's plan grid on a paraboloid opening towards the
+/// front net, through the bottom hinges.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RearNet {
+    /// Focal length of the rear paraboloid, m: its rise above the bottom hinges
+    /// is `(R² − ρ²)/(4 F_rear)` at plan distance ρ from the aperture centre.
+    pub focal_length_m: f64,
+    /// Target mean tension of the rear net's interior cables, N.
+    pub mean_tension_n: f64,
+}
+
+/// Cable properties.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cables {
+    /// Cable diameter, m.
+    pub diameter_m: f64,
+    /// Young's modulus of the cables, Pa.
+    pub youngs_modulus_pa: f64,
+    /// Density of the cable material, kg/m³.
+    pub density_kg_per_m3: f64,
+    /// Upper bound [q] on any force density, N/m (paper eq. 5).
+    pub max_force_density_n_per_m: f64,
+}
+
+/// Which truss model the design loop uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TrussModel {
+    /// No deformation: the conventional method.
+    Rigid,
+    /// Small-displacement frame.
+    Linear,
+    /// Geometrically exact beams and rigid hinges (paper §3).
+    #[default]
+    Exact,
+}
+
+/// The physics a scene asks for (DESIGN §8); what is not asked for is not built.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Effects {
+    /// The truss model of the design loop.
+    pub truss: TrussModel,
+}
+
+/// An invalid scene: every variant names the file or the key.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// Reading the file failed.
+    #[error("reading {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML of the scene format (unknown or missing key, wrong
+    /// type); the message names the key and the line.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A value is out of its valid range.
+    #[error("`{key}`: {reason}")]
+    Invalid {
+        /// The dotted key, e.g. `truss.tube_inner_diameter_m`.
+        key: &'static str,
+        /// Why the value is rejected.
+        reason: String,
+    },
+}
+
+impl SceneError {
+    /// The key at fault, when the error is about one value.
+    pub fn key(&self) -> Option<&'static str> {
+        match self {
+            SceneError::Invalid { key, .. } => Some(key),
+            _ => None,
+        }
+    }
+
+    pub(crate) fn invalid(key: &'static str, reason: impl Into<String>) -> Self {
+        SceneError::Invalid {
+            key,
+            reason: reason.into(),
+        }
+    }
+}
+
+impl Scene {
+    /// Reads, parses and validates a scene file; the name defaults to the file stem.
+    pub fn read(path: &Path) -> Result<Scene, SceneError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: shown.clone(),
+            source,
+        })?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Scene::from_toml(&text, &stem).map_err(|e| match e {
+            SceneError::Parse { message, .. } => SceneError::Parse {
+                path: shown,
+                message,
+            },
+            other => other,
+        })
+    }
+
+    /// Parses and validates scene text; `default_name` is used when it has no `name`.
+    pub fn from_toml(text: &str, default_name: &str) -> Result<Scene, SceneError> {
+        let mut scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
+            path: "<scene>".into(),
+            message: e.to_string(),
+        })?;
+        if scene.name.is_empty() {
+            scene.name = default_name.to_string();
+        }
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Checks every value against its valid range.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        if self.name.is_empty()
+            || !self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+            || self.name.starts_with('.')
+        {
+            return Err(SceneError::invalid(
+                "name",
+                format!(
+                    "{:?} must be non-empty and use only letters, digits, '-', '_' and '.' \
+                     (it names the results folder)",
+                    self.name
+                ),
+            ));
+        }
+        let r = &self.reflector;
+        positive("reflector.aperture_diameter_m", r.aperture_diameter_m)?;
+        positive("reflector.focal_length_m", r.focal_length_m)?;
+        non_negative("reflector.offset_m", r.offset_m)?;
+
+        let t = &self.truss;
+        if t.bays < 3 {
+            return Err(SceneError::invalid(
+                "truss.bays",
+                format!("{} bays: a ring truss needs at least 3", t.bays),
+            ));
+        }
+        if t.bays > MAX_BAYS {
+            return Err(SceneError::invalid(
+                "truss.bays",
+                format!("{} bays: more than the {MAX_BAYS} supported", t.bays),
+            ));
+        }
+        positive("truss.height_m", t.height_m)?;
+        positive("truss.tube_outer_diameter_m", t.tube_outer_diameter_m)?;
+        non_negative("truss.tube_inner_diameter_m", t.tube_inner_diameter_m)?;
+        if t.tube_inner_diameter_m >= t.tube_outer_diameter_m {
+            return Err(SceneError::invalid(
+                "truss.tube_inner_diameter_m",
+                format!(
+                    "{} m must be smaller than truss.tube_outer_diameter_m = {} m",
+                    t.tube_inner_diameter_m, t.tube_outer_diameter_m
+                ),
+            ));
+        }
+        positive("truss.youngs_modulus_pa", t.youngs_modulus_pa)?;
+        positive("truss.shear_modulus_pa", t.shear_modulus_pa)?;
+        positive("truss.density_kg_per_m3", t.density_kg_per_m3)?;
+
+        let f = &self.front_net;
+        if f.rings < 2 {
+            return Err(SceneError::invalid(
+                "front_net.rings",
+                format!(
+                    "{} ring(s): at least 2 are needed for free boundary nodes between \
+                     the truss attachments",
+                    f.rings
+                ),
+            ));
+        }
+        positive("front_net.boundary_sag_ratio", f.boundary_sag_ratio)?;
+        if f.boundary_sag_ratio >= 0.5 {
+            return Err(SceneError::invalid(
+                "front_net.boundary_sag_ratio",
+                format!(
+                    "{} must be below 0.5 (sag as a fraction of the bay chord)",
+                    f.boundary_sag_ratio
+                ),
+            ));
+        }
+        positive("front_net.mean_tension_n", f.mean_tension_n)?;
+        positive("rear_net.focal_length_m", self.rear_net.focal_length_m)?;
+        positive("rear_net.mean_tension_n", self.rear_net.mean_tension_n)?;
+
+        let c = &self.cables;
+        positive("cables.diameter_m", c.diameter_m)?;
+        positive("cables.youngs_modulus_pa", c.youngs_modulus_pa)?;
+        positive("cables.density_kg_per_m3", c.density_kg_per_m3)?;
+        positive("cables.max_force_density_n_per_m", c.max_force_density_n_per_m)?;
+        Ok(())
+    }
+
+    /// Radius of the aperture circle, m.
+    pub fn aperture_radius_m(&self) -> f64 {
+        0.5 * self.reflector.aperture_diameter_m
+    }
+}
+
+/// Largest number of bays a scene may ask for.
+pub const MAX_BAYS: usize = 10_000;
+
+fn positive(key: &'static str, value: f64) -> Result<(), SceneError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(
+            key,
+            format!("{value} must be a finite number > 0"),
+        ))
+    }
+}
+
+fn non_negative(key: &'static str, value: f64) -> Result<(), SceneError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(
+            key,
+            format!("{value} must be a finite number ≥ 0"),
+        ))
+    }
+}
