@@ -227,9 +227,8 @@ impl FdmStructure {
         }
 
         let n_free = self.free.len();
-        let mut rhs = Mat::<f64>::from_fn(n_free, 3, |f, c| {
-            loads.map_or(0.0, |p| p[self.free[f]][c])
-        });
+        let mut rhs =
+            Mat::<f64>::from_fn(n_free, 3, |f, c| loads.map_or(0.0, |p| p[self.free[f]][c]));
         for (&[i, j], &qk) in self.edges.iter().zip(q) {
             let (fi, fj) = (self.free_index[i], self.free_index[j]);
             if fi != NONE && fj == NONE {
@@ -243,21 +242,21 @@ impl FdmStructure {
             }
         }
 
-        let factor = match &self.symbolic {
-            None => None,
-            Some(symbolic) => {
-                let values = self.d_values(q);
-                let d = SparseColMatRef::new(self.d_pattern.as_ref(), &values);
-                let llt = Llt::try_new_with_symbolic(symbolic.clone(), d, Side::Lower).map_err(
-                    |e| FdmError::NotPositiveDefinite {
-                        n_free,
-                        reason: format!("{e:?}"),
-                    },
-                )?;
-                llt.solve_in_place(rhs.as_mut());
-                Some(llt)
-            }
-        };
+        let factor =
+            match &self.symbolic {
+                None => None,
+                Some(symbolic) => {
+                    let values = self.d_values(q);
+                    let d = SparseColMatRef::new(self.d_pattern.as_ref(), &values);
+                    let llt = Llt::try_new_with_symbolic(symbolic.clone(), d, Side::Lower)
+                        .map_err(|e| FdmError::NotPositiveDefinite {
+                            n_free,
+                            reason: format!("{e:?}"),
+                        })?;
+                    llt.solve_in_place(rhs.as_mut());
+                    Some(llt)
+                }
+            };
 
         let mut xyz = nodes.to_vec();
         for (f, &i) in self.free.iter().enumerate() {
@@ -285,8 +284,8 @@ impl FdmStructure {
             for (node, sign) in [(i, 1.0), (j, -1.0)] {
                 let f = self.free_index[node];
                 if f != NONE {
-                    for c in 0..3 {
-                        triplets.push(Triplet::new(3 * f + c, k, sign * uk[c]));
+                    for (c, &uc) in uk.iter().enumerate() {
+                        triplets.push(Triplet::new(3 * f + c, k, sign * uc));
                     }
                 }
             }
@@ -464,7 +463,11 @@ impl Equilibrium {
         dj_dq: Option<&[f64]>,
     ) -> Vec<f64> {
         assert_eq!(dj_dx.len(), structure.n_nodes, "dj_dx: one row per node");
-        assert_eq!(self.edges_vectors_m.len(), structure.n_edges(), "structure mismatch");
+        assert_eq!(
+            self.edges_vectors_m.len(),
+            structure.n_edges(),
+            "structure mismatch"
+        );
         let mut gradient = match dj_dq {
             Some(g) => {
                 assert_eq!(g.len(), structure.n_edges(), "dj_dq: one entry per edge");
@@ -475,9 +478,8 @@ impl Equilibrium {
         let Some(factor) = &self.factor else {
             return gradient;
         };
-        let mut lambda = Mat::<f64>::from_fn(structure.free.len(), 3, |f, c| {
-            dj_dx[structure.free[f]][c]
-        });
+        let mut lambda =
+            Mat::<f64>::from_fn(structure.free.len(), 3, |f, c| dj_dx[structure.free[f]][c]);
         factor.solve_in_place(lambda.as_mut());
         let lambda_of = |node: usize, c: usize| {
             let f = structure.free_index[node];
@@ -487,7 +489,12 @@ impl Equilibrium {
                 lambda[(f, c)]
             }
         };
-        for (k, (&[i, j], uk)) in structure.edges.iter().zip(&self.edges_vectors_m).enumerate() {
+        for (k, (&[i, j], uk)) in structure
+            .edges
+            .iter()
+            .zip(&self.edges_vectors_m)
+            .enumerate()
+        {
             let projected: f64 = (0..3)
                 .map(|c| (lambda_of(i, c) - lambda_of(j, c)) * uk[c])
                 .sum();

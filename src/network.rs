@@ -194,8 +194,11 @@ impl Network {
             path: shown.clone(),
             source,
         })?;
-        let network: Network = serde_json::from_str(&text)
-            .map_err(|source| NetworkError::Json { path: shown, source })?;
+        let network: Network =
+            serde_json::from_str(&text).map_err(|source| NetworkError::Json {
+                path: shown,
+                source,
+            })?;
         network.validate()?;
         Ok(network)
     }
@@ -239,7 +242,12 @@ impl Network {
         let lengths = [
             ("q", self.q.len(), m, "edges"),
             ("loads", self.loads.as_ref().map_or(n, Vec::len), n, "nodes"),
-            ("groups", self.groups.as_ref().map_or(m, Vec::len), m, "edges"),
+            (
+                "groups",
+                self.groups.as_ref().map_or(m, Vec::len),
+                m,
+                "edges",
+            ),
         ];
         for (field, found, expected, per) in lengths {
             if found != expected {
@@ -293,7 +301,10 @@ impl Network {
         }
         for (edge, &value) in self.q.iter().enumerate() {
             if !value.is_finite() {
-                return Err(NetworkError::NotFinite { field: "q", index: edge });
+                return Err(NetworkError::NotFinite {
+                    field: "q",
+                    index: edge,
+                });
             }
             if value <= 0.0 {
                 return Err(NetworkError::NonPositiveQ { edge, value });

@@ -300,7 +300,10 @@ impl Scene {
         positive("cables.diameter_m", c.diameter_m)?;
         positive("cables.youngs_modulus_pa", c.youngs_modulus_pa)?;
         positive("cables.density_kg_per_m3", c.density_kg_per_m3)?;
-        positive("cables.max_force_density_n_per_m", c.max_force_density_n_per_m)?;
+        positive(
+            "cables.max_force_density_n_per_m",
+            c.max_force_density_n_per_m,
+        )?;
         Ok(())
     }
 
@@ -311,7 +314,7 @@ impl Scene {
 }
 
 /// Largest number of bays a scene may ask for.
-pub const MAX_BAYS: usize = 10_000;
+pub const MAX_BAYS: usize = 1_000;
 
 fn positive(key: &'static str, value: f64) -> Result<(), SceneError> {
     if value.is_finite() && value > 0.0 {

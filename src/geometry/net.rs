@@ -23,7 +23,7 @@ pub const MAX_NODES: usize = 4_000_000;
 
 /// Shortest cable allowed, as a fraction of the aperture diameter: a mesh density
 /// that produces shorter cables is rejected as degenerate.
-pub const MIN_CABLE_LENGTH_RATIO: f64 = 1e-5;
+pub const MIN_CABLE_LENGTH_RATIO: f64 = 1e-4;
 
 /// A scene's cable network with its design geometry and its truss layout.
 #[derive(Debug, Clone)]
@@ -153,6 +153,20 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
                 ),
             )
         })?;
+    // The shortest cable of the sector grid is the first ring's, chord/rings in
+    // plan: reject a degenerate density before allocating the net.
+    let diameter = scene.reflector.aperture_diameter_m;
+    let chord = diameter * (std::f64::consts::PI / bays as f64).sin();
+    let first_ring_cable = chord / rings as f64;
+    if first_ring_cable < MIN_CABLE_LENGTH_RATIO * diameter {
+        return Err(SceneError::invalid(
+            "front_net.rings",
+            format!(
+                "{rings} rings on {bays} bays make degenerate cables: the first ring's cables are \
+                 {first_ring_cable:.3e} m long, below {MIN_CABLE_LENGTH_RATIO:e} × aperture"
+            ),
+        ));
+    }
     let paraboloid = Paraboloid {
         focal_length_m: scene.reflector.focal_length_m,
     };
@@ -174,7 +188,11 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
         .collect();
     nodes.extend(grid.points.iter().map(|&[x, y]| {
         let rise = (r2 - aperture.rho_squared(x, y)) / (4.0 * rear_focal);
-        [x, y, aperture.rim_plane_z(&paraboloid, x) - scene.truss.height_m + rise]
+        [
+            x,
+            y,
+            aperture.rim_plane_z(&paraboloid, x) - scene.truss.height_m + rise,
+        ]
     }));
     // The grid's vertices must coincide with the hinges (same construction).
     debug_assert!(grid.vertices.iter().zip(&truss.top_m).all(|(&v, t)| {
@@ -200,7 +218,6 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
         }
     }
     let tied: Vec<usize> = (0..n_front).filter(|&i| !fixed_mask[i]).collect();
-    let diameter = scene.reflector.aperture_diameter_m;
     let mut shortest_tie = f64::INFINITY;
     for &i in &tied {
         shortest_tie = shortest_tie.min(nodes[i][2] - nodes[i + n_front][2]);
@@ -220,12 +237,19 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
         ));
     }
 
-    let lengths: Vec<f64> = edges_vectors(&edges, &nodes).into_iter().map(norm3).collect();
-    let (shortest_edge, shortest) = lengths
-        .iter()
-        .copied()
-        .enumerate()
-        .fold((0, f64::INFINITY), |best, (k, l)| if l < best.1 { (k, l) } else { best });
+    let lengths: Vec<f64> = edges_vectors(&edges, &nodes)
+        .into_iter()
+        .map(norm3)
+        .collect();
+    let (shortest_edge, shortest) =
+        lengths
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |best, (k, l)| if l < best.1 { (k, l) } else { best },
+            );
     if shortest < MIN_CABLE_LENGTH_RATIO * diameter {
         return Err(SceneError::invalid(
             "front_net.rings",
@@ -241,7 +265,11 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
     let network = Network {
         nodes,
         edges,
-        fixed: front_attachments.iter().chain(&rear_attachments).copied().collect(),
+        fixed: front_attachments
+            .iter()
+            .chain(&rear_attachments)
+            .copied()
+            .collect(),
         q,
         loads: None,
         groups: Some(groups.iter().map(|g| g.as_str().to_string()).collect()),
@@ -302,7 +330,10 @@ fn initial_force_densities(
         sum / count.max(1) as f64
     };
     let scallop = scene.front_net.rings as f64 / (8.0 * scene.front_net.boundary_sag_ratio);
-    let (front, rear) = (scene.front_net.mean_tension_n, scene.rear_net.mean_tension_n);
+    let (front, rear) = (
+        scene.front_net.mean_tension_n,
+        scene.rear_net.mean_tension_n,
+    );
     let per_group = |group: CableGroup| match group {
         CableGroup::Front => front / mean_length(group),
         CableGroup::Boundary => front * scallop / mean_length(group),
@@ -323,8 +354,13 @@ fn initial_force_densities(
             pull[j] -= qk * dz;
         }
     }
-    let tie_edges: Vec<usize> = (0..edges.len()).filter(|&k| groups[k] == CableGroup::Tie).collect();
-    let mean_pull = tie_edges.iter().map(|&k| pull[edges[k][0]].abs()).sum::<f64>()
+    let tie_edges: Vec<usize> = (0..edges.len())
+        .filter(|&k| groups[k] == CableGroup::Tie)
+        .collect();
+    let mean_pull = tie_edges
+        .iter()
+        .map(|&k| pull[edges[k][0]].abs())
+        .sum::<f64>()
         / tie_edges.len().max(1) as f64;
     let fallback = front / mean_length(CableGroup::Front);
     let q_tie = if mean_pull > 0.0 {

@@ -63,8 +63,13 @@ mod tests {
 
     #[test]
     fn rim_of_offset_paraboloid_is_planar() {
-        let p = Paraboloid { focal_length_m: 7.0 };
-        let a = Aperture { radius_m: 5.0, offset_m: 6.0 };
+        let p = Paraboloid {
+            focal_length_m: 7.0,
+        };
+        let a = Aperture {
+            radius_m: 5.0,
+            offset_m: 6.0,
+        };
         for k in 0..12 {
             let [x, y] = a.rim_point(k as f64 * 0.5);
             let err = p.z(x, y) - a.rim_plane_z(&p, x);

@@ -23,7 +23,10 @@ impl RingTrussLayout {
                 [x, y, paraboloid.z(x, y)]
             })
             .collect();
-        let bottom_m = top_m.iter().map(|&[x, y, z]| [x, y, z - height_m]).collect();
+        let bottom_m = top_m
+            .iter()
+            .map(|&[x, y, z]| [x, y, z - height_m])
+            .collect();
         RingTrussLayout { top_m, bottom_m }
     }
 

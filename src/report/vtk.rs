@@ -15,7 +15,11 @@ use crate::network::Network;
 /// # Panics
 /// If `nodes` or `forces_n` do not match the network's shape.
 #[track_caller]
-pub fn network_vtu(network: &Network, nodes: Option<&[[f64; 3]]>, forces_n: Option<&[f64]>) -> String {
+pub fn network_vtu(
+    network: &Network,
+    nodes: Option<&[[f64; 3]]>,
+    forces_n: Option<&[f64]>,
+) -> String {
     let nodes = nodes.unwrap_or(&network.nodes);
     assert_eq!(nodes.len(), network.n_nodes(), "nodes: one row per node");
     if let Some(f) = forces_n {
@@ -44,7 +48,9 @@ pub fn network_vtu(network: &Network, nodes: Option<&[[f64; 3]]>, forces_n: Opti
     let _ = writeln!(s, "<!-- groups: {} -->", labels.join(", "));
     s.push_str("<UnstructuredGrid>\n");
     let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{m}\">");
-    s.push_str("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    s.push_str(
+        "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+    );
     for p in nodes {
         let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
     }

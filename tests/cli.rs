@@ -1,0 +1,163 @@
+//! The command line: outputs of `mesh` and `fdm`, and clean failure (message,
+//! exit code 2, no output file) on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn ringmesh(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(args)
+        .output()
+        .expect("run ringmesh")
+}
+
+fn problem(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("problems")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn path(dir: &tempfile::TempDir, name: &str) -> PathBuf {
+    dir.path().join(name)
+}
+
+#[test]
+fn mesh_writes_network_and_vtu_and_fdm_solves_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "hex");
+    let run = ringmesh(&[
+        "mesh",
+        &problem("small-hex.toml"),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("74 (62 free, 12 fixed)"), "{stdout}");
+    assert!(
+        stdout.contains("tie 31") && stdout.contains("shortest cable"),
+        "{stdout}"
+    );
+    let vtu = std::fs::read_to_string(out.join("mesh.vtu")).unwrap();
+    assert!(vtu.contains("NumberOfPoints=\"74\" NumberOfCells=\"211\""));
+
+    let network = out.join("network.json");
+    let json: Value = serde_json::from_str(&std::fs::read_to_string(&network).unwrap()).unwrap();
+    assert_eq!(json["nodes"].as_array().unwrap().len(), 74);
+    assert_eq!(json["groups"].as_array().unwrap().len(), 211);
+
+    let result = path(&dir, "eq.json");
+    let run = ringmesh(&[
+        "fdm",
+        network.to_str().unwrap(),
+        "-o",
+        result.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let eq: Value = serde_json::from_str(&std::fs::read_to_string(&result).unwrap()).unwrap();
+    for (key, len) in [
+        ("nodes", 74),
+        ("lengths", 211),
+        ("forces", 211),
+        ("reactions", 12),
+    ] {
+        assert_eq!(eq[key].as_array().unwrap().len(), len, "{key}");
+    }
+    let max_force = eq["forces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .fold(0.0, f64::max);
+    assert!(eq["max_residual"].as_f64().unwrap() <= 1e-9 * max_force);
+}
+
+fn assert_rejected(args: &[&str], output: &Path, needle: &str) {
+    let run = ringmesh(args);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: expected {needle:?} in {stderr}"
+    );
+    assert!(!output.exists(), "{args:?} left {}", output.display());
+}
+
+#[test]
+fn bad_scene_fails_with_exit_2_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = path(&dir, "bad.toml");
+    let text = std::fs::read_to_string(problem("small-hex.toml")).unwrap();
+    std::fs::write(
+        &scene,
+        text.replace(
+            "tube_inner_diameter_m = 0.022",
+            "tube_inner_diameter_m = 0.03",
+        ),
+    )
+    .unwrap();
+    let out = path(&dir, "out");
+    let args = ["mesh", scene.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    assert_rejected(&args, &out, "truss.tube_inner_diameter_m");
+}
+
+#[test]
+fn bad_networks_fail_with_exit_2_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = r#"{"nodes": [[0,0,0],[1,0,0],[0,1,0],[0.3,0.3,0.2]],
+                   "edges": [[3,0],[3,1],[3,2]], "fixed": [0,1,2], "q": [1,2,3]}"#;
+    let cases = [
+        (good.replace("[3,2]]", "[3,9]]"), "edges[2]"),
+        (good.replace("\"q\": [1,2,3]", "\"q\": [1,0,3]"), "q[1]"),
+        (good.replace("\"q\": [1,2,3]", "\"q\": [1,-2,3]"), "q[1]"),
+        (
+            good.replace("\"fixed\": [0,1,2]", "\"fixed\": [0,1,2,7]"),
+            "fixed[3]",
+        ),
+        (
+            good.replace("[0.3,0.3,0.2]]", "[0.3,0.3,0.2],[5,5,5]]"),
+            "not connected",
+        ),
+        (
+            good.replace("[1,0,0]", "[1,0,1e999]"),
+            "number out of range",
+        ),
+        (
+            good.replace("\"q\": [1,2,3]", "\"q\": [1,2]"),
+            "`q` has 2 entries",
+        ),
+        (good.replace("[[3,0]", "[[3,3]"), "edges[0]"),
+        (good.replace("\"q\"", "\"qq\""), "qq"),
+    ];
+    let out = path(&dir, "eq.json");
+    let input = path(&dir, "good.json");
+    std::fs::write(&input, good).unwrap();
+    let run = ringmesh(&["fdm", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    std::fs::remove_file(&out).unwrap();
+    for (k, (text, needle)) in cases.iter().enumerate() {
+        let input = path(&dir, &format!("bad{k}.json"));
+        std::fs::write(&input, text).unwrap();
+        assert_rejected(
+            &["fdm", input.to_str().unwrap(), "-o", out.to_str().unwrap()],
+            &out,
+            needle,
+        );
+    }
+}
