@@ -17,6 +17,8 @@
 //!   interchange JSON format;
 //! * [`fdm`] — the force density method: forward equilibrium, reactions, the
 //!   equilibrium matrix `A(x)` of the inverse form and adjoint sensitivities;
+//! * [`uniformity`] — the tension-uniformity problem (paper eq. 5) and its
+//!   pluggable solvers (bisection, LP, gradient, least squares);
 //! * [`report`] — files a run writes (atomically): JSON, VTK.
 #![warn(missing_docs)]
 
@@ -26,6 +28,7 @@ pub mod network;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod uniformity;
 
 pub use fdm::{Equilibrium, FdmError, FdmStructure};
 pub use network::{CableGroup, Network, NetworkError};
@@ -43,6 +46,9 @@ pub enum Error {
     /// The force density method failed on a valid network.
     #[error(transparent)]
     Fdm(#[from] FdmError),
+    /// A uniformity problem or solver failed.
+    #[error(transparent)]
+    Uniformity(#[from] uniformity::UniformityError),
     /// Reading or writing a file.
     #[error(transparent)]
     Report(#[from] report::ReportError),
@@ -55,6 +61,7 @@ impl Error {
         match self {
             Error::Scene(_) | Error::Network(_) => true,
             Error::Fdm(e) => e.is_bad_input(),
+            Error::Uniformity(e) => e.is_bad_input(),
             Error::Report(e) => e.is_bad_input(),
         }
     }

@@ -1,0 +1,212 @@
+//! Conic programs for the clarabel-based solvers: assembly of `s = b − A x ∈ K`
+//! block by block, the equilibrium rows `A(x) q = p`, status classification, and
+//! the slack analysis that names the nodes of an infeasible geometry.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+use super::{UniformityError, UniformityProblem};
+
+/// Constraint rows `s = b − A x`, grouped into cones in order.
+#[derive(Debug, Default)]
+pub(crate) struct ConicProgram {
+    n_vars: usize,
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    vals: Vec<f64>,
+    b: Vec<f64>,
+    cones: Vec<SupportedConeT<f64>>,
+    /// Kind of the cone being filled and its row count so far.
+    open: Option<(Cone, usize)>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Cone {
+    Zero,
+    Nonnegative,
+}
+
+impl ConicProgram {
+    pub(crate) fn new(n_vars: usize) -> Self {
+        ConicProgram {
+            n_vars,
+            ..Default::default()
+        }
+    }
+
+    /// Appends one row `b − a·x` to a cone of `kind` (merging consecutive rows of
+    /// the same kind into one cone).
+    pub(crate) fn row(&mut self, kind: Cone, entries: &[(usize, f64)], b: f64) {
+        let row = self.b.len();
+        for &(col, val) in entries {
+            debug_assert!(col < self.n_vars);
+            self.rows.push(row);
+            self.cols.push(col);
+            self.vals.push(val);
+        }
+        self.b.push(b);
+        match &mut self.open {
+            Some((open, count)) if *open == kind => *count += 1,
+            _ => {
+                self.close();
+                self.open = Some((kind, 1));
+            }
+        }
+    }
+
+    fn close(&mut self) {
+        if let Some((kind, count)) = self.open.take() {
+            self.cones.push(match kind {
+                Cone::Zero => SupportedConeT::ZeroConeT(count),
+                Cone::Nonnegative => SupportedConeT::NonnegativeConeT(count),
+            });
+        }
+    }
+
+    /// Appends the equilibrium rows `p − A(x) q` (3 per free node, `q` the first
+    /// n_edges variables) as a zero cone, or — with `epsilon > 0` — as the
+    /// second-order cone `‖A q − p‖₂ ≤ ε`.
+    pub(crate) fn equilibrium(&mut self, problem: &UniformityProblem, epsilon: f64) {
+        self.close();
+        let a = problem
+            .structure()
+            .equilibrium_matrix(&problem.network().nodes);
+        let p = problem.free_loads();
+        let first = self.b.len();
+        let offset = if epsilon > 0.0 {
+            self.b.push(epsilon);
+            1
+        } else {
+            0
+        };
+        self.b.extend_from_slice(&p);
+        let (symbolic, values) = a.parts();
+        for col in 0..a.ncols() {
+            let range = symbolic.col_range(col);
+            for (&row, &val) in symbolic.row_idx()[range.clone()].iter().zip(&values[range]) {
+                self.rows.push(first + offset + row);
+                self.cols.push(col);
+                self.vals.push(val);
+            }
+        }
+        self.cones.push(if epsilon > 0.0 {
+            SupportedConeT::SecondOrderConeT(1 + p.len())
+        } else {
+            SupportedConeT::ZeroConeT(p.len())
+        });
+    }
+
+    /// Solves `min ½xᵀPx + cᵀx` (P = 0) subject to the rows.
+    pub(crate) fn solve(mut self, c: &[f64]) -> ConicOutcome {
+        self.close();
+        let n_rows = self.b.len();
+        let a = CscMatrix::new_from_triplets(n_rows, self.n_vars, self.rows, self.cols, self.vals);
+        let p = CscMatrix::zeros((self.n_vars, self.n_vars));
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .direct_solve_method("faer".to_string())
+            .build()
+            .expect("valid clarabel settings");
+        let mut solver = match DefaultSolver::new(&p, c, &a, &self.b, &self.cones, settings) {
+            Ok(s) => s,
+            Err(e) => {
+                return ConicOutcome {
+                    class: Class::Failed,
+                    status: format!("setup: {e}"),
+                    x: Vec::new(),
+                    iterations: 0,
+                }
+            }
+        };
+        solver.solve();
+        let solution = &solver.solution;
+        let class = match solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => Class::Feasible,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                Class::Infeasible
+            }
+            _ => Class::Failed,
+        };
+        ConicOutcome {
+            class,
+            status: format!("{:?}", solution.status),
+            x: solution.x.clone(),
+            iterations: solution.iterations as usize,
+        }
+    }
+}
+
+/// What a conic solve says, in the terms the solvers act on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Class {
+    /// `Solved` or `AlmostSolved`.
+    Feasible,
+    /// `PrimalInfeasible` or `AlmostPrimalInfeasible`.
+    Infeasible,
+    /// Any other status.
+    Failed,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct ConicOutcome {
+    pub class: Class,
+    /// clarabel's status, verbatim.
+    pub status: String,
+    pub x: Vec<f64>,
+    pub iterations: usize,
+}
+
+impl ConicOutcome {
+    /// The status, when it is anything but a plain `Solved`: for the design's warnings.
+    pub(crate) fn warning(&self, context: &str) -> Option<String> {
+        (self.status != "Solved").then(|| format!("{context}: clarabel status {}", self.status))
+    }
+}
+
+/// Names the nodes of a geometry with no strictly positive self-stress: solves
+/// `max Σ y_k` s.t. `A q = p`, `ℓ_k q_k ≥ y_k`, `0 ≤ y_k ≤ 1` — cables with
+/// `y_k < ½` at the optimum are slack in every equilibrium — and returns the
+/// free nodes at their ends (ascending).
+pub(crate) fn slack_nodes(problem: &UniformityProblem) -> Result<Vec<usize>, UniformityError> {
+    let m = problem.network().n_edges();
+    let lengths = problem.lengths_m();
+    let mut program = ConicProgram::new(2 * m);
+    program.equilibrium(problem, 0.0);
+    for k in 0..m {
+        // ℓ q − y ≥ 0, y ≥ 0, 1 − y ≥ 0
+        program.row(Cone::Nonnegative, &[(k, -lengths[k]), (m + k, 1.0)], 0.0);
+        program.row(Cone::Nonnegative, &[(m + k, -1.0)], 0.0);
+        program.row(Cone::Nonnegative, &[(m + k, 1.0)], 1.0);
+    }
+    let mut c = vec![0.0; 2 * m];
+    c[m..].fill(-1.0);
+    let outcome = program.solve(&c);
+    if outcome.class != Class::Feasible {
+        return Err(UniformityError::Invalid(format!(
+            "the slack analysis of the prescribed geometry failed: clarabel status {}",
+            outcome.status
+        )));
+    }
+    let structure = problem.structure();
+    let mut nodes: Vec<usize> = (0..m)
+        .filter(|&k| outcome.x[m + k] < 0.5)
+        .flat_map(|k| problem.network().edges[k])
+        .filter(|&i| structure.free_index(i).is_some())
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    Ok(nodes)
+}
+
+/// The infeasibility error for `problem`, naming its slack nodes.
+pub(crate) fn infeasible(problem: &UniformityProblem) -> UniformityError {
+    match slack_nodes(problem) {
+        Ok(nodes) => UniformityError::Infeasible {
+            count: nodes.len(),
+            nodes: nodes.into_iter().take(12).collect(),
+        },
+        Err(e) => e,
+    }
+}

@@ -1,0 +1,162 @@
+//! What every uniformity solver returns: a [`Design`] judged the same way for all
+//! of them, by a forward FDM solve with the returned `q`.
+
+use std::time::Duration;
+
+use serde::Serialize;
+
+use super::{UniformityError, UniformityProblem};
+
+/// How a solver stopped. Not converging is a status, not an error: a caller can
+/// never mistake it for a result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// The solver's optimality test holds.
+    Converged,
+    /// The iteration limit was reached first.
+    MaxIterations,
+    /// No further progress was possible before the optimality test held.
+    Stalled,
+    /// No feasible `q` exists (for that solver's formulation).
+    Infeasible,
+    /// The inner solver reported a numerical failure.
+    NumericalError,
+}
+
+/// Tension statistics of a set of cables.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TensionSpread {
+    /// A uniformity set's name or a group label.
+    pub name: String,
+    /// Number of cables.
+    pub cables: usize,
+    /// Smallest tension, N.
+    pub min_tension_n: f64,
+    /// Largest tension, N.
+    pub max_tension_n: f64,
+    /// Mean tension, N.
+    pub mean_tension_n: f64,
+    /// `Tmax/Tmin`.
+    pub ratio: f64,
+}
+
+impl TensionSpread {
+    fn of(name: &str, edges: impl Iterator<Item = usize>, tensions: &[f64]) -> Self {
+        let (mut min, mut max, mut sum, mut count) = (f64::INFINITY, 0.0f64, 0.0, 0usize);
+        for k in edges {
+            min = min.min(tensions[k]);
+            max = max.max(tensions[k]);
+            sum += tensions[k];
+            count += 1;
+        }
+        TensionSpread {
+            name: name.to_string(),
+            cables: count,
+            min_tension_n: min,
+            max_tension_n: max,
+            mean_tension_n: sum / count.max(1) as f64,
+            ratio: max / min,
+        }
+    }
+}
+
+/// A pretension design: force densities and what they do to the network.
+#[derive(Debug, Clone, Serialize)]
+pub struct Design {
+    /// The solver that made it.
+    pub solver: String,
+    /// Force densities, N/m: n_edges.
+    pub q: Vec<f64>,
+    /// Tensions of the forward solve with `q`, N: n_edges.
+    pub tensions_n: Vec<f64>,
+    /// Cable lengths of the forward solve, m: n_edges.
+    pub lengths_m: Vec<f64>,
+    /// Node positions of the forward solve, m: n_nodes × 3.
+    pub nodes_xyz_m: Vec<[f64; 3]>,
+    /// Support reactions, N, in the order of the network's `fixed`.
+    pub reactions_n: Vec<[f64; 3]>,
+    /// `Tmax/Tmin` over each uniformity set.
+    pub sets: Vec<TensionSpread>,
+    /// Tension spread of every group label.
+    pub groups: Vec<TensionSpread>,
+    /// The largest set ratio.
+    pub ratio: f64,
+    /// Out-of-balance force of `q` on the prescribed geometry, N.
+    pub max_residual_n: f64,
+    /// Largest cable tension, N.
+    pub max_tension_n: f64,
+    /// RMS surface error of the forward solve, m.
+    pub surface_rms_m: f64,
+    /// Largest surface error of the forward solve, m.
+    pub surface_max_m: f64,
+    /// How the solver stopped.
+    pub termination: Termination,
+    /// Iterations of the solver (bisection steps, L-BFGS iterations, …).
+    pub iterations: usize,
+    /// Wall time of the solve, s.
+    pub time_s: f64,
+    /// Everything the inner solvers reported other than plain success.
+    pub warnings: Vec<String>,
+}
+
+impl Design {
+    /// Judges `q` on `problem`: forward solve, tensions, spreads, residual, surface
+    /// error. The caller supplies how its solver stopped.
+    pub fn evaluate(
+        problem: &UniformityProblem,
+        solver: &str,
+        q: Vec<f64>,
+        termination: Termination,
+        iterations: usize,
+        elapsed: Duration,
+        warnings: Vec<String>,
+    ) -> Result<Design, UniformityError> {
+        let eq = problem.forward(&q)?;
+        let tensions = eq.edges_forces_n.clone();
+        let network = problem.network();
+        let sets: Vec<TensionSpread> = problem
+            .sets()
+            .iter()
+            .map(|s| TensionSpread::of(&s.name, s.edges.iter().copied(), &tensions))
+            .collect();
+        let mut labels: Vec<&str> = Vec::new();
+        for k in 0..network.n_edges() {
+            let g = network.group_of(k);
+            if !labels.contains(&g) {
+                labels.push(g);
+            }
+        }
+        let groups = labels
+            .iter()
+            .map(|g| {
+                TensionSpread::of(
+                    g,
+                    (0..network.n_edges()).filter(|&k| network.group_of(k) == *g),
+                    &tensions,
+                )
+            })
+            .collect();
+        let errors = problem.surface_errors_m(&eq.nodes_xyz_m);
+        let surface_max_m = errors.iter().map(|e| e.abs()).fold(0.0, f64::max);
+        Ok(Design {
+            solver: solver.to_string(),
+            ratio: sets.iter().map(|s| s.ratio).fold(0.0, f64::max),
+            max_residual_n: problem.prescribed_residual_n(&q),
+            max_tension_n: eq.max_force_n(),
+            surface_rms_m: problem.surface_rms_m(&eq.nodes_xyz_m),
+            surface_max_m,
+            q,
+            tensions_n: tensions,
+            lengths_m: eq.edges_lengths_m,
+            nodes_xyz_m: eq.nodes_xyz_m,
+            reactions_n: eq.reactions_n,
+            sets,
+            groups,
+            termination,
+            iterations,
+            time_s: elapsed.as_secs_f64(),
+            warnings,
+        })
+    }
+}

@@ -1,0 +1,139 @@
+//! Tension-uniformity solvers (paper eq. 5, DESIGN §4): one problem, one
+//! [`UniformitySolver`] trait, one file per strategy, all returning a [`Design`].
+//!
+//! | solver | formulation | knob |
+//! |---|---|---|
+//! | [`Lp`] | one LP `min s`, `1 ≤ T_k ≤ s`, `A q = 0`, rescaled (homogeneous, one set) | — |
+//! | [`Bisection`] | ratio bisection of LP feasibility, or SOCP with `‖A q − p‖ ≤ ε` | ε |
+//! | [`Gradient`] | free geometry, adjoint gradient, L-BFGS | weight of the ratio term |
+//! | [`LeastSquares`] | `min ‖L q − T̄‖²` s.t. `A q = p`, or Tikhonov `λ` | λ |
+
+mod bisection;
+mod conic;
+mod design;
+mod gradient;
+mod least_squares;
+mod lp;
+mod problem;
+
+pub use bisection::Bisection;
+pub use design::{Design, TensionSpread, Termination};
+pub use gradient::Gradient;
+pub use least_squares::LeastSquares;
+pub use lp::Lp;
+pub use problem::{SurfaceTarget, UniformityProblem, UniformitySet};
+
+use crate::fdm::FdmError;
+
+/// A uniformity problem or solve that cannot go on.
+#[derive(Debug, thiserror::Error)]
+pub enum UniformityError {
+    /// The problem is ill-posed (empty set, bad bound, zero-length cable, …).
+    #[error("invalid uniformity problem: {0}")]
+    Invalid(String),
+    /// The solver cannot treat this kind of problem (e.g. `lp` with loads).
+    #[error("the `{solver}` solver cannot solve this problem: {reason}")]
+    Unsupported {
+        /// The solver.
+        solver: &'static str,
+        /// Why, and which solver can.
+        reason: String,
+    },
+    /// No strictly positive self-stress balances the prescribed geometry.
+    #[error(
+        "no strictly positive force densities balance the prescribed geometry: cables at \
+         nodes {} can only be slack ({count} nodes in all; e.g. boundary nodes on a straight \
+         chord between attachments: sag the boundary inward)",
+        list(.nodes)
+    )]
+    Infeasible {
+        /// The first few nodes with a cable that must be slack.
+        nodes: Vec<usize>,
+        /// How many such nodes there are.
+        count: usize,
+    },
+    /// The inner solver failed numerically (its status, verbatim).
+    #[error("the `{solver}` solver failed: {status}")]
+    SolverFailed {
+        /// The solver.
+        solver: &'static str,
+        /// The inner solver's status.
+        status: String,
+    },
+    /// A forward solve failed.
+    #[error(transparent)]
+    Fdm(#[from] FdmError),
+}
+
+impl UniformityError {
+    /// True when the cause is the caller's input.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            UniformityError::Invalid(_)
+            | UniformityError::Unsupported { .. }
+            | UniformityError::Infeasible { .. } => true,
+            UniformityError::SolverFailed { .. } => false,
+            UniformityError::Fdm(e) => e.is_bad_input(),
+        }
+    }
+}
+
+fn list(nodes: &[usize]) -> String {
+    nodes
+        .iter()
+        .map(usize::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A strategy that turns a [`UniformityProblem`] into a [`Design`].
+pub trait UniformitySolver: Send + Sync {
+    /// The name used on the command line and in reports.
+    fn name(&self) -> &'static str;
+    /// The accuracy knob's value (ε, weight, λ), if the solver has one.
+    fn knob(&self) -> Option<f64> {
+        None
+    }
+    /// Solves the problem.
+    fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError>;
+}
+
+/// The solvers, by name (the command line's choice).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolverKind {
+    /// Ratio bisection over LP/SOCP feasibility (clarabel).
+    Bisection,
+    /// One LP (clarabel): the homogeneous single-set baseline.
+    Lp,
+    /// Free-geometry adjoint L-BFGS (argmin).
+    Gradient,
+    /// Constrained or Tikhonov least squares (faer).
+    LeastSquares,
+}
+
+impl SolverKind {
+    /// The solver with its default settings, or with its accuracy knob set.
+    pub fn build(self, knob: Option<f64>) -> Box<dyn UniformitySolver> {
+        match self {
+            SolverKind::Bisection => Box::new(Bisection {
+                epsilon_n: knob.unwrap_or(0.0),
+                ..Bisection::default()
+            }),
+            SolverKind::Lp => Box::new(Lp::default()),
+            SolverKind::Gradient => Box::new(match knob {
+                Some(weight) => Gradient {
+                    weight,
+                    ..Gradient::default()
+                },
+                None => Gradient::default(),
+            }),
+            SolverKind::LeastSquares => Box::new(LeastSquares {
+                lambda: knob,
+                ..LeastSquares::default()
+            }),
+        }
+    }
+}

@@ -1,0 +1,266 @@
+//! The tension-uniformity problem (paper eq. 5, DESIGN §4), formulated once for
+//! every solver: a prescribed geometry, uniformity sets, bounds, loads, and the
+//! surface whose accuracy a design is judged by.
+
+use crate::fdm::{Equilibrium, FdmStructure};
+use crate::geometry::{Paraboloid, ReflectorMesh};
+use crate::network::{norm3, Network};
+
+use super::UniformityError;
+
+/// Cables whose tensions should be uniform, with their target mean tension.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UniformitySet {
+    /// Name shown in reports: a group label, or labels joined with `+`.
+    pub name: String,
+    /// The cables, ascending.
+    pub edges: Vec<usize>,
+    /// Target mean tension, N. The first set's target fixes the pretension level
+    /// of a homogeneous problem; the other sets' levels follow from equilibrium.
+    pub mean_tension_n: f64,
+}
+
+/// What the surface accuracy of a design is measured against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SurfaceTarget {
+    /// Vertical distance to the paraboloid (the reflector's surface error).
+    Paraboloid(Paraboloid),
+    /// Distance to the prescribed node positions.
+    Prescribed,
+}
+
+/// The uniformity problem: find `q` with `A(x) q = p` for the prescribed
+/// geometry `x`, `0 < q ≤ [q]`, minimising `Tmax/Tmin` over each uniformity set.
+#[derive(Debug, Clone)]
+pub struct UniformityProblem {
+    network: Network,
+    structure: FdmStructure,
+    lengths_m: Vec<f64>,
+    sets: Vec<UniformitySet>,
+    surface_nodes: Vec<usize>,
+    surface: SurfaceTarget,
+    /// Upper bound `[q]` on every force density, N/m (paper eq. 5).
+    pub max_force_density_n_per_m: f64,
+    /// Cables outside every uniformity set keep a tension of at least this
+    /// fraction of the first set's mean tension, so that `q > 0` strictly.
+    pub min_tension_fraction: f64,
+}
+
+impl UniformityProblem {
+    /// The problem on a network whose node positions are the prescribed geometry.
+    ///
+    /// `sets`: (name, cables, target mean tension) per uniformity set; every set
+    /// non-empty. `surface_nodes`: the nodes whose accuracy is reported (free).
+    pub fn new(
+        network: Network,
+        sets: Vec<UniformitySet>,
+        surface_nodes: Vec<usize>,
+        surface: SurfaceTarget,
+        max_force_density_n_per_m: f64,
+    ) -> Result<Self, UniformityError> {
+        let structure = FdmStructure::new(&network)?;
+        if sets.is_empty() {
+            return Err(UniformityError::Invalid("no uniformity set".into()));
+        }
+        for set in &sets {
+            if set.edges.is_empty() {
+                return Err(UniformityError::Invalid(format!(
+                    "uniformity set `{}` has no cable",
+                    set.name
+                )));
+            }
+            if let Some(&k) = set.edges.iter().find(|&&k| k >= network.n_edges()) {
+                return Err(UniformityError::Invalid(format!(
+                    "uniformity set `{}` names cable {k}, but the network has {}",
+                    set.name,
+                    network.n_edges()
+                )));
+            }
+            if !(set.mean_tension_n.is_finite() && set.mean_tension_n > 0.0) {
+                return Err(UniformityError::Invalid(format!(
+                    "uniformity set `{}`: mean tension {} must be > 0",
+                    set.name, set.mean_tension_n
+                )));
+            }
+        }
+        if !(max_force_density_n_per_m.is_finite() && max_force_density_n_per_m > 0.0) {
+            return Err(UniformityError::Invalid(format!(
+                "maximum force density {max_force_density_n_per_m} must be > 0"
+            )));
+        }
+        let lengths_m: Vec<f64> = network.edges_vectors().into_iter().map(norm3).collect();
+        if let Some(k) = lengths_m.iter().position(|&l| !(l > 0.0)) {
+            return Err(UniformityError::Invalid(format!(
+                "cable {k} (nodes {:?}) has zero length in the prescribed geometry",
+                network.edges[k]
+            )));
+        }
+        if let Some(&i) = surface_nodes
+            .iter()
+            .find(|&&i| structure.free_index(i).is_none())
+        {
+            return Err(UniformityError::Invalid(format!(
+                "surface node {i} is not free"
+            )));
+        }
+        Ok(UniformityProblem {
+            network,
+            structure,
+            lengths_m,
+            sets,
+            surface_nodes,
+            surface,
+            max_force_density_n_per_m,
+            min_tension_fraction: 1e-3,
+        })
+    }
+
+    /// The front-net problem of a scene's mesh: uniformity over each named group
+    /// (its own level; the first group's level is its scene target), the front
+    /// net's free nodes judged against the paraboloid.
+    pub fn from_mesh(
+        mesh: &ReflectorMesh,
+        groups: &[(crate::CableGroup, f64)],
+        max_force_density_n_per_m: f64,
+    ) -> Result<Self, UniformityError> {
+        let sets = groups
+            .iter()
+            .map(|&(group, mean_tension_n)| UniformitySet {
+                name: group.as_str().to_string(),
+                edges: (0..mesh.groups.len())
+                    .filter(|&k| mesh.groups[k] == group)
+                    .collect(),
+                mean_tension_n,
+            })
+            .collect();
+        let fixed = mesh.network.fixed_mask();
+        let surface_nodes = (0..mesh.n_front_nodes).filter(|&i| !fixed[i]).collect();
+        Self::new(
+            mesh.network.clone(),
+            sets,
+            surface_nodes,
+            SurfaceTarget::Paraboloid(mesh.paraboloid),
+            max_force_density_n_per_m,
+        )
+    }
+
+    /// The network: prescribed positions, cables, supports, loads, groups.
+    pub fn network(&self) -> &Network {
+        &self.network
+    }
+
+    /// The force density structure (factor once, refactor per `q`).
+    pub fn structure(&self) -> &FdmStructure {
+        &self.structure
+    }
+
+    /// Cable lengths of the prescribed geometry, m.
+    pub fn lengths_m(&self) -> &[f64] {
+        &self.lengths_m
+    }
+
+    /// The uniformity sets.
+    pub fn sets(&self) -> &[UniformitySet] {
+        &self.sets
+    }
+
+    /// Nodes whose accuracy is reported.
+    pub fn surface_nodes(&self) -> &[usize] {
+        &self.surface_nodes
+    }
+
+    /// What accuracy is measured against.
+    pub fn surface(&self) -> SurfaceTarget {
+        self.surface
+    }
+
+    /// True when the network carries a non-zero load (then the problem is not
+    /// scale-free and its pretension level follows from the loads).
+    pub fn has_loads(&self) -> bool {
+        self.network
+            .loads
+            .iter()
+            .flatten()
+            .any(|p| p.iter().any(|&v| v != 0.0))
+    }
+
+    /// Loads at the free nodes, stacked `3f + c`: the right-hand side `p` of
+    /// `A q = p`.
+    pub fn free_loads(&self) -> Vec<f64> {
+        let mut p = vec![0.0; 3 * self.structure.free_nodes().len()];
+        if let Some(loads) = &self.network.loads {
+            for (f, &i) in self.structure.free_nodes().iter().enumerate() {
+                p[3 * f..3 * f + 3].copy_from_slice(&loads[i]);
+            }
+        }
+        p
+    }
+
+    /// Cables in no uniformity set.
+    pub fn other_edges(&self) -> Vec<usize> {
+        let mut in_set = vec![false; self.network.n_edges()];
+        for set in &self.sets {
+            for &k in &set.edges {
+                in_set[k] = true;
+            }
+        }
+        (0..in_set.len()).filter(|&k| !in_set[k]).collect()
+    }
+
+    /// Smallest tension a cable outside the sets may carry, N.
+    pub fn min_other_tension_n(&self) -> f64 {
+        self.min_tension_fraction * self.sets[0].mean_tension_n
+    }
+
+    /// Largest out-of-balance force of `q` on the prescribed geometry,
+    /// `max_i |(A q − p)_i|` over free nodes (Euclidean per node), N.
+    pub fn prescribed_residual_n(&self, q: &[f64]) -> f64 {
+        let x = &self.network.nodes;
+        let mut r = vec![[0.0; 3]; self.network.n_nodes()];
+        for (&[i, j], &qk) in self.network.edges.iter().zip(q) {
+            for c in 0..3 {
+                let f = qk * (x[i][c] - x[j][c]);
+                r[i][c] += f;
+                r[j][c] -= f;
+            }
+        }
+        let loads = self.network.loads.as_deref();
+        self.structure
+            .free_nodes()
+            .iter()
+            .map(|&i| {
+                let p = loads.map_or([0.0; 3], |l| l[i]);
+                norm3([r[i][0] - p[0], r[i][1] - p[1], r[i][2] - p[2]])
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Forward equilibrium for `q` from the prescribed supports and loads.
+    pub fn forward(&self, q: &[f64]) -> Result<Equilibrium, UniformityError> {
+        Ok(self
+            .structure
+            .solve(q, &self.network.nodes, self.network.loads.as_deref())?)
+    }
+
+    /// Signed surface error of every surface node of `nodes` (n_nodes × 3), m:
+    /// vertical distance to the paraboloid, or distance to the prescribed
+    /// position.
+    pub fn surface_errors_m(&self, nodes: &[[f64; 3]]) -> Vec<f64> {
+        self.surface_nodes
+            .iter()
+            .map(|&i| match self.surface {
+                SurfaceTarget::Paraboloid(p) => p.axial_deviation(nodes[i]),
+                SurfaceTarget::Prescribed => {
+                    let t = self.network.nodes[i];
+                    norm3([nodes[i][0] - t[0], nodes[i][1] - t[1], nodes[i][2] - t[2]])
+                }
+            })
+            .collect()
+    }
+
+    /// RMS of [`Self::surface_errors_m`], m.
+    pub fn surface_rms_m(&self, nodes: &[[f64; 3]]) -> f64 {
+        let e = self.surface_errors_m(nodes);
+        (e.iter().map(|v| v * v).sum::<f64>() / e.len().max(1) as f64).sqrt()
+    }
+}
