@@ -2,8 +2,15 @@
 //! with `A q = p` (or `‖A q − p‖₂ ≤ ε`, an SOCP), `t_g ≤ ℓ_k q_k ≤ r t_g` for every
 //! cable `k` of set `g`, `q ≤ [q]`, the first set's mean tension at its target,
 //! the other sets' levels and the other cables' tensions at least
-//! `min_tension_fraction · t_0`? Each trial is one clarabel solve; infeasibility is
-//! read from clarabel's status. Handles several sets and nodal loads.
+//! `min_tension_fraction · t_0`? Handles several sets and nodal loads.
+//!
+//! Each trial is one clarabel solve of the *elastic* form: `min σ` with the upper
+//! ratio bound relaxed to `ℓ_k q_k ≤ r t_g + σ T̄_0`. It is strictly feasible and
+//! bounded whenever a positive equilibrium exists, so the interior-point method
+//! stays well conditioned right at the optimal ratio (a plain feasibility problem
+//! degenerates there); the trial ratio is feasible iff `σ* ≤ 0`. A geometry with
+//! no strictly positive equilibrium makes the elastic form itself infeasible,
+//! which clarabel's status reports at the first trial.
 
 use std::time::Instant;
 
@@ -35,14 +42,16 @@ impl Default for Bisection {
 }
 
 impl Bisection {
-    /// The feasibility program for ratio `r`: variables `[q (m), t (sets)]`.
+    /// The elastic program for ratio `r`: variables `[q (m), t (sets), σ]`.
     fn trial(&self, problem: &UniformityProblem, r: f64) -> super::conic::ConicOutcome {
         let lengths = problem.lengths_m();
         let m = problem.network().n_edges();
         let sets = problem.sets();
         let level = |g: usize| m + g;
+        let sigma = m + sets.len();
+        let scale = sets[0].mean_tension_n;
         let fraction = problem.min_tension_fraction;
-        let mut program = ConicProgram::new(m + sets.len());
+        let mut program = ConicProgram::new(m + sets.len() + 1);
         program.equilibrium(problem, self.epsilon_n);
         // Pretension level: mean tension of the first set at its target.
         let first = &sets[0];
@@ -55,7 +64,11 @@ impl Bisection {
         for (g, set) in sets.iter().enumerate() {
             for &k in &set.edges {
                 program.row(Cone::Nonnegative, &[(k, -lengths[k]), (level(g), 1.0)], 0.0);
-                program.row(Cone::Nonnegative, &[(k, lengths[k]), (level(g), -r)], 0.0);
+                program.row(
+                    Cone::Nonnegative,
+                    &[(k, lengths[k]), (level(g), -r), (sigma, -scale)],
+                    0.0,
+                );
             }
             if g > 0 {
                 program.row(
@@ -85,7 +98,34 @@ impl Bisection {
                 problem.max_force_density_n_per_m,
             );
         }
-        program.solve(&vec![0.0; m + sets.len()])
+        let mut c = vec![0.0; m + sets.len() + 1];
+        c[sigma] = 1.0;
+        program.solve(&c)
+    }
+
+    /// Runs a trial: `Ok(Some(q))` when ratio `r` is feasible, `Ok(None)` when not.
+    fn feasible(
+        &self,
+        problem: &UniformityProblem,
+        r: f64,
+        iterations: &mut usize,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Vec<f64>>, UniformityError> {
+        let m = problem.network().n_edges();
+        let outcome = self.trial(problem, r);
+        *iterations += 1;
+        warnings.extend(outcome.warning(&format!("ratio {r:.9}")));
+        match outcome.class {
+            Class::Feasible => {
+                let sigma = outcome.x[m + problem.sets().len()];
+                Ok((sigma <= 0.0).then(|| outcome.x[..m].to_vec()))
+            }
+            Class::Infeasible => Err(infeasible(problem)),
+            Class::Failed => Err(UniformityError::SolverFailed {
+                solver: "bisection",
+                status: format!("at ratio {r}: {}", outcome.status),
+            }),
+        }
     }
 
     /// The largest set ratio of a trial solution.
@@ -125,37 +165,25 @@ impl UniformitySolver for Bisection {
                 self.epsilon_n
             )));
         }
-        let m = problem.network().n_edges();
         let mut warnings = Vec::new();
         let mut iterations = 0;
-        let mut best: Option<Vec<f64>> = None;
         let (mut lo, mut hi) = (1.0, 2.0);
         // Grow the bracket until a trial is feasible.
-        while best.is_none() {
+        let mut best = loop {
+            if let Some(q) = self.feasible(problem, hi, &mut iterations, &mut warnings)? {
+                hi = Self::achieved_ratio(problem, &q).min(hi);
+                break q;
+            }
+            lo = hi;
+            hi *= 4.0;
             if hi > self.max_ratio {
-                return Err(infeasible(problem));
+                return Err(UniformityError::Invalid(format!(
+                    "no design with a ratio below {} exists (positive equilibria exist, but \
+                     only more uneven ones)",
+                    self.max_ratio
+                )));
             }
-            let outcome = self.trial(problem, hi);
-            iterations += 1;
-            warnings.extend(outcome.warning(&format!("ratio {hi:.6}")));
-            match outcome.class {
-                Class::Feasible => {
-                    let q = outcome.x[..m].to_vec();
-                    hi = Self::achieved_ratio(problem, &q).min(hi);
-                    best = Some(q);
-                }
-                Class::Infeasible => {
-                    lo = hi;
-                    hi *= 4.0;
-                }
-                Class::Failed => {
-                    return Err(UniformityError::SolverFailed {
-                        solver: "bisection",
-                        status: format!("at ratio {hi}: {}", outcome.status),
-                    })
-                }
-            }
-        }
+        };
         let mut termination = Termination::Converged;
         while hi - lo > self.relative_tolerance * hi {
             if iterations >= self.max_iterations {
@@ -163,28 +191,15 @@ impl UniformitySolver for Bisection {
                 break;
             }
             let r = 0.5 * (lo + hi);
-            let outcome = self.trial(problem, r);
-            iterations += 1;
-            warnings.extend(outcome.warning(&format!("ratio {r:.9}")));
-            match outcome.class {
-                Class::Feasible => {
-                    let q = outcome.x[..m].to_vec();
+            match self.feasible(problem, r, &mut iterations, &mut warnings)? {
+                Some(q) => {
                     hi = Self::achieved_ratio(problem, &q).clamp(lo, r);
-                    best = Some(q);
+                    best = q;
                 }
-                Class::Infeasible => lo = r,
-                Class::Failed => {
-                    // Keep the bracket; the best feasible q stands.
-                    warnings.push(format!(
-                        "ratio {r:.9}: stopped, clarabel status {}",
-                        outcome.status
-                    ));
-                    termination = Termination::NumericalError;
-                    break;
-                }
+                None => lo = r,
             }
         }
-        let q = best.expect("a feasible trial was found");
+        let q = best;
         Design::evaluate(
             problem,
             self.name(),

@@ -98,45 +98,61 @@ impl ConicProgram {
         });
     }
 
-    /// Solves `min ½xᵀPx + cᵀx` (P = 0) subject to the rows.
+    /// Solves `min cᵀx` subject to the rows. The KKT systems of these programs
+    /// are often degenerate near the optimum, so a solve that ends in a numerical
+    /// failure is retried with the other LDLᵀ backend and stronger static
+    /// regularisation; the outcome says which attempt answered.
     pub(crate) fn solve(mut self, c: &[f64]) -> ConicOutcome {
         self.close();
         let n_rows = self.b.len();
         let a = CscMatrix::new_from_triplets(n_rows, self.n_vars, self.rows, self.cols, self.vals);
         let p = CscMatrix::zeros((self.n_vars, self.n_vars));
-        let settings = DefaultSettingsBuilder::default()
-            .verbose(false)
-            .direct_solve_method("faer".to_string())
-            .build()
-            .expect("valid clarabel settings");
-        let mut solver = match DefaultSolver::new(&p, c, &a, &self.b, &self.cones, settings) {
-            Ok(s) => s,
-            Err(e) => {
-                return ConicOutcome {
-                    class: Class::Failed,
-                    status: format!("setup: {e}"),
-                    x: Vec::new(),
-                    iterations: 0,
+        let mut outcome = None;
+        for (attempt, (method, regularisation)) in ATTEMPTS.iter().enumerate() {
+            let settings = DefaultSettingsBuilder::default()
+                .verbose(false)
+                .direct_solve_method(method.to_string())
+                .static_regularization_constant(*regularisation)
+                .build()
+                .expect("valid clarabel settings");
+            let mut solver = match DefaultSolver::new(&p, c, &a, &self.b, &self.cones, settings) {
+                Ok(s) => s,
+                Err(e) => {
+                    return ConicOutcome {
+                        class: Class::Failed,
+                        status: format!("setup: {e}"),
+                        x: Vec::new(),
+                        iterations: 0,
+                        retried: attempt > 0,
+                    }
                 }
+            };
+            solver.solve();
+            let solution = &solver.solution;
+            let class = match solution.status {
+                SolverStatus::Solved | SolverStatus::AlmostSolved => Class::Feasible,
+                SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                    Class::Infeasible
+                }
+                _ => Class::Failed,
+            };
+            outcome = Some(ConicOutcome {
+                class,
+                status: format!("{:?}", solution.status),
+                x: solution.x.clone(),
+                iterations: solution.iterations as usize,
+                retried: attempt > 0,
+            });
+            if class != Class::Failed {
+                break;
             }
-        };
-        solver.solve();
-        let solution = &solver.solution;
-        let class = match solution.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => Class::Feasible,
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                Class::Infeasible
-            }
-            _ => Class::Failed,
-        };
-        ConicOutcome {
-            class,
-            status: format!("{:?}", solution.status),
-            x: solution.x.clone(),
-            iterations: solution.iterations as usize,
         }
+        outcome.expect("at least one attempt")
     }
 }
+
+/// clarabel's LDLᵀ backend and static regularisation, in the order tried.
+const ATTEMPTS: [(&str, f64); 2] = [("faer", 1e-7), ("qdldl", 1e-6)];
 
 /// What a conic solve says, in the terms the solvers act on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -156,12 +172,21 @@ pub(crate) struct ConicOutcome {
     pub status: String,
     pub x: Vec<f64>,
     pub iterations: usize,
+    /// The first attempt failed numerically and a retry answered.
+    pub retried: bool,
 }
 
 impl ConicOutcome {
-    /// The status, when it is anything but a plain `Solved`: for the design's warnings.
+    /// A reduced-accuracy status (`Almost…`) or a retried solve, for the design's
+    /// warnings.
     pub(crate) fn warning(&self, context: &str) -> Option<String> {
-        (self.status != "Solved").then(|| format!("{context}: clarabel status {}", self.status))
+        let retried = if self.retried {
+            " after a numerical failure and retry"
+        } else {
+            ""
+        };
+        (self.status.starts_with("Almost") || self.retried)
+            .then(|| format!("{context}: clarabel status {}{retried}", self.status))
     }
 }
 
