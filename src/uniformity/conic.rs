@@ -199,9 +199,9 @@ pub(crate) fn slack_nodes(problem: &UniformityProblem) -> Result<Vec<usize>, Uni
     let lengths = problem.lengths_m();
     let mut program = ConicProgram::new(2 * m);
     program.equilibrium(problem, 0.0);
-    for k in 0..m {
+    for (k, &length) in lengths.iter().enumerate() {
         // ℓ q − y ≥ 0, y ≥ 0, 1 − y ≥ 0
-        program.row(Cone::Nonnegative, &[(k, -lengths[k]), (m + k, 1.0)], 0.0);
+        program.row(Cone::Nonnegative, &[(k, -length), (m + k, 1.0)], 0.0);
         program.row(Cone::Nonnegative, &[(m + k, -1.0)], 0.0);
         program.row(Cone::Nonnegative, &[(m + k, 1.0)], 1.0);
     }

@@ -122,7 +122,7 @@ impl SolverKind {
                 epsilon_n: knob.unwrap_or(0.0),
                 ..Bisection::default()
             }),
-            SolverKind::Lp => Box::new(Lp::default()),
+            SolverKind::Lp => Box::new(Lp),
             SolverKind::Gradient => Box::new(match knob {
                 Some(weight) => Gradient {
                     weight,

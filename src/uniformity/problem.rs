@@ -89,7 +89,7 @@ impl UniformityProblem {
             )));
         }
         let lengths_m: Vec<f64> = network.edges_vectors().into_iter().map(norm3).collect();
-        if let Some(k) = lengths_m.iter().position(|&l| !(l > 0.0)) {
+        if let Some(k) = lengths_m.iter().position(|&l| l.is_nan() || l <= 0.0) {
             return Err(UniformityError::Invalid(format!(
                 "cable {k} (nodes {:?}) has zero length in the prescribed geometry",
                 network.edges[k]
