@@ -5,6 +5,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use ringmesh::run::Progress;
+use ringmesh::uniformity::SolverKind;
 
 /// Pretension design of the cable mesh of ring-truss deployable reflectors.
 #[derive(Parser)]
@@ -43,6 +46,84 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// One tension-uniformity design for the scene's theoretical (rigid) boundary.
+    ///
+    /// Writes design.json (q, tensions, positions, ratio per set and group, surface
+    /// RMS, termination, time) and cables.csv (id,group,i,j,q,tension_n,length_m,
+    /// cut_length_m); prints ratio, RMS and time.
+    ///
+    /// Example: ringmesh optimize problems/small-hex.toml --solver bisection
+    Optimize {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// The uniformity solver.
+        #[arg(long, value_enum, default_value = "bisection")]
+        solver: SolverKind,
+        /// Output folder [default: results/<scene name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Tension uniformity on a network file whose node positions are the prescribed
+    /// geometry (free = not fixed).
+    ///
+    /// The other cables only need 0 < q. Writes q, tensions, ratio, max_residual,
+    /// solver, termination, iterations, time_s.
+    ///
+    /// Example: ringmesh uniformity net.json --solver lp --groups front,boundary -o out.json
+    Uniformity {
+        /// The network file (interchange JSON).
+        network: PathBuf,
+        /// The uniformity solver.
+        #[arg(long, value_enum, default_value = "bisection")]
+        solver: SolverKind,
+        /// Groups whose union is made uniform [default: front, or all cables when
+        /// the file has no groups].
+        #[arg(long, value_delimiter = ',')]
+        groups: Option<Vec<String>>,
+        /// Target mean tension of those cables, N [default: that of the file's q].
+        #[arg(long)]
+        mean_tension: Option<f64>,
+        /// Output JSON file.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// The design front: ratio against actual surface RMS, sweeping each solver's
+    /// accuracy knob (ε for bisection, weight for gradient, λ for least squares).
+    ///
+    /// Writes front.csv (solver,knob,ratio,rms_mm,time_s), front.png and front.svg.
+    ///
+    /// Example: ringmesh front problems/small-hex.toml --solvers bisection,least-squares --points 8
+    Front {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// Solvers to sweep.
+        #[arg(
+            long,
+            value_enum,
+            value_delimiter = ',',
+            default_value = "bisection,gradient,least-squares"
+        )]
+        solvers: Vec<SolverKind>,
+        /// Knob values per solver.
+        #[arg(long, default_value_t = 8)]
+        points: usize,
+        /// Output folder [default: results/<scene name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal).
+struct Bar(ProgressBar);
+
+impl Progress for Bar {
+    fn start(&self, total: usize) {
+        self.0.set_length(total as u64);
+    }
+    fn step(&self, message: &str) {
+        self.0.set_message(message.to_string());
+        self.0.inc(1);
+    }
 }
 
 fn main() -> ExitCode {
@@ -59,6 +140,79 @@ fn main() -> ExitCode {
             println!("max residual: {:.3e} N", o.max_residual);
             println!("wrote {}", output.display());
         }),
+        Command::Optimize {
+            scene,
+            solver,
+            output,
+        } => ringmesh::run::optimize(scene, *solver, output.as_deref()).map(|(d, written)| {
+            for set in &d.sets {
+                println!(
+                    "ratio over {}: {:.6} ({} cables)",
+                    set.name, set.ratio, set.cables
+                );
+            }
+            println!(
+                "surface RMS: {:.3e} mm (max {:.3e} mm)",
+                1e3 * d.surface_rms_m,
+                1e3 * d.surface_max_m
+            );
+            println!(
+                "termination: {:?} after {} iterations, {:.3} s",
+                d.termination, d.iterations, d.time_s
+            );
+            for w in &d.warnings {
+                println!("warning: {w}");
+            }
+            for path in written {
+                println!("wrote {}", path.display());
+            }
+        }),
+        Command::Uniformity {
+            network,
+            solver,
+            groups,
+            mean_tension,
+            output,
+        } => ringmesh::run::uniformity(network, *solver, groups.as_deref(), *mean_tension, output)
+            .map(|o| {
+                println!("ratio: {:.6}", o.ratio);
+                println!("max residual: {:.3e} N", o.max_residual);
+                println!(
+                    "termination: {:?} after {} iterations, {:.3} s",
+                    o.termination, o.iterations, o.time_s
+                );
+                println!("wrote {}", output.display());
+            }),
+        Command::Front {
+            scene,
+            solvers,
+            points,
+            output,
+        } => {
+            let bar = ProgressBar::new(0);
+            bar.set_style(
+                ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
+                    .expect("valid template"),
+            );
+            let progress = Bar(bar);
+            let result =
+                ringmesh::run::front(scene, solvers, *points, output.as_deref(), &progress);
+            progress.0.finish_and_clear();
+            result.map(|(points, written)| {
+                for p in &points {
+                    match &p.outcome {
+                        Ok(t) => println!(
+                            "{:?} knob {:.3e}: ratio {:.6}, RMS {:.3e} mm, {:.3} s ({t:?})",
+                            p.solver, p.knob, p.ratio, p.rms_mm, p.time_s
+                        ),
+                        Err(e) => println!("{:?} knob {:.3e}: failed: {e}", p.solver, p.knob),
+                    }
+                }
+                for path in written {
+                    println!("wrote {}", path.display());
+                }
+            })
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -460,7 +460,7 @@ pub(crate) fn edges_vectors(edges: &[[usize; 2]], nodes: &[[f64; 3]]) -> Vec<[f6
 }
 
 /// Euclidean norm of a 3-vector.
-pub(crate) fn norm3(v: [f64; 3]) -> f64 {
+pub fn norm3(v: [f64; 3]) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 

@@ -27,9 +27,44 @@ pub struct Scene {
     pub rear_net: RearNet,
     /// Cable properties (all nets and ties).
     pub cables: Cables,
+    /// Which cables the design makes uniform (DESIGN §4).
+    #[serde(default)]
+    pub uniformity: Uniformity,
     /// Which physics the model includes (DESIGN §8).
     #[serde(default)]
     pub effects: Effects,
+}
+
+/// A net whose interior tensions can be made uniform.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UniformNet {
+    /// The front net's interior cables (target `front_net.mean_tension_n`).
+    Front,
+    /// The rear net's interior cables (target `rear_net.mean_tension_n`).
+    Rear,
+}
+
+/// The uniformity groups of the design: each its own tension level, one common
+/// ratio `Tmax/Tmin` minimised. The first group's mean tension is held at its
+/// target; the others' levels follow from equilibrium.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Uniformity {
+    /// The groups, first one fixing the pretension level.
+    pub groups: Vec<UniformNet>,
+    /// Cables outside every group keep at least this fraction of the first
+    /// group's smallest tension (so every q is strictly positive).
+    pub min_tension_fraction: f64,
+}
+
+impl Default for Uniformity {
+    fn default() -> Self {
+        Uniformity {
+            groups: vec![UniformNet::Front],
+            min_tension_fraction: 1e-3,
+        }
+    }
 }
 
 /// The paraboloid `z = (x² + y²)/(4F)` and the aperture on it.
@@ -115,6 +150,19 @@ pub struct Cables {
     pub density_kg_per_m3: f64,
     /// Upper bound [q] on any force density, N/m (paper eq. 5).
     pub max_force_density_n_per_m: f64,
+}
+
+impl Cables {
+    /// Axial stiffness `EA` of one cable, N.
+    pub fn axial_stiffness_n(&self) -> f64 {
+        self.youngs_modulus_pa * std::f64::consts::PI * self.diameter_m * self.diameter_m / 4.0
+    }
+
+    /// Unstressed (cut) length of a cable of length `length_m` under `tension_n`:
+    /// `L0 = ℓ/(1 + T/EA)` (DESIGN §7).
+    pub fn cut_length_m(&self, length_m: f64, tension_n: f64) -> f64 {
+        length_m / (1.0 + tension_n / self.axial_stiffness_n())
+    }
 }
 
 /// Which truss model the design loop uses.
@@ -296,6 +344,31 @@ impl Scene {
         positive("rear_net.focal_length_m", self.rear_net.focal_length_m)?;
         positive("rear_net.mean_tension_n", self.rear_net.mean_tension_n)?;
 
+        let u = &self.uniformity;
+        if u.groups.is_empty() {
+            return Err(SceneError::invalid(
+                "uniformity.groups",
+                "at least one group is needed",
+            ));
+        }
+        if let Some(g) = u
+            .groups
+            .iter()
+            .enumerate()
+            .find_map(|(i, g)| u.groups[..i].contains(g).then_some(g))
+        {
+            return Err(SceneError::invalid(
+                "uniformity.groups",
+                format!("{g:?} is listed twice"),
+            ));
+        }
+        if !(u.min_tension_fraction > 0.0 && u.min_tension_fraction < 1.0) {
+            return Err(SceneError::invalid(
+                "uniformity.min_tension_fraction",
+                format!("{} must lie in (0, 1)", u.min_tension_fraction),
+            ));
+        }
+
         let c = &self.cables;
         positive("cables.diameter_m", c.diameter_m)?;
         positive("cables.youngs_modulus_pa", c.youngs_modulus_pa)?;
@@ -305,6 +378,18 @@ impl Scene {
             c.max_force_density_n_per_m,
         )?;
         Ok(())
+    }
+
+    /// The uniformity groups with their target mean tensions, N.
+    pub fn uniformity_targets(&self) -> Vec<(crate::CableGroup, f64)> {
+        self.uniformity
+            .groups
+            .iter()
+            .map(|g| match g {
+                UniformNet::Front => (crate::CableGroup::Front, self.front_net.mean_tension_n),
+                UniformNet::Rear => (crate::CableGroup::Rear, self.rear_net.mean_tension_n),
+            })
+            .collect()
     }
 
     /// Radius of the aperture circle, m.

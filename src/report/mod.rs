@@ -2,6 +2,8 @@
 //! the target folder and renamed into place, so a reader never sees half a file
 //! and an interrupted run leaves earlier results intact.
 
+mod csv;
+mod plot;
 mod vtk;
 
 use std::io::Write;
@@ -9,6 +11,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+pub use csv::{cables_csv, front_csv};
+pub use plot::front_plot;
 pub use vtk::network_vtu;
 
 /// Writing a result failed.
@@ -21,6 +25,14 @@ pub enum ReportError {
         path: PathBuf,
         /// The cause.
         source: std::io::Error,
+    },
+    /// A plot could not be drawn.
+    #[error("drawing {path}: {message}")]
+    Plot {
+        /// The file.
+        path: PathBuf,
+        /// The backend's message.
+        message: String,
     },
     /// A value could not be serialised (a non-finite number in JSON, say).
     #[error("serialising {path}: {source}")]
@@ -66,6 +78,34 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
         let _ = std::fs::remove_file(&temporary);
     }
     result.map_err(io)
+}
+
+/// Lets `draw` write a file at a temporary path (same folder, same extension, so
+/// format-by-extension writers work), then renames it over `path`.
+pub fn write_atomic_with(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), String> {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&parent).map_err(|e| e.to_string())?;
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let temporary = parent.join(format!(".{name}.{}.tmp.{extension}", std::process::id()));
+    let result = draw(&temporary)
+        .and_then(|()| std::fs::rename(&temporary, path).map_err(|e| e.to_string()));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&temporary);
+    }
+    result
 }
 
 /// Serialises `value` as pretty JSON and writes it atomically.

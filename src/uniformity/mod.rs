@@ -11,6 +11,7 @@
 mod bisection;
 mod conic;
 mod design;
+mod front;
 mod gradient;
 mod least_squares;
 mod lp;
@@ -18,6 +19,7 @@ mod problem;
 
 pub use bisection::Bisection;
 pub use design::{Design, TensionSpread, Termination};
+pub use front::{design_front, knob_values, FrontPoint};
 pub use gradient::Gradient;
 pub use least_squares::LeastSquares;
 pub use lp::Lp;

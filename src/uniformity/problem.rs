@@ -39,7 +39,7 @@ pub struct UniformityProblem {
     sets: Vec<UniformitySet>,
     surface_nodes: Vec<usize>,
     surface: SurfaceTarget,
-    /// Upper bound `[q]` on every force density, N/m (paper eq. 5).
+    /// Upper bound `[q]` on every force density, N/m (paper eq. 5); may be infinite.
     pub max_force_density_n_per_m: f64,
     /// Cables outside every uniformity set keep a tension of at least this
     /// fraction of the first set's mean tension, so that `q > 0` strictly.
@@ -83,7 +83,7 @@ impl UniformityProblem {
                 )));
             }
         }
-        if !(max_force_density_n_per_m.is_finite() && max_force_density_n_per_m > 0.0) {
+        if max_force_density_n_per_m.is_nan() || max_force_density_n_per_m <= 0.0 {
             return Err(UniformityError::Invalid(format!(
                 "maximum force density {max_force_density_n_per_m} must be > 0"
             )));
