@@ -161,3 +161,146 @@ fn bad_networks_fail_with_exit_2_and_write_nothing() {
         );
     }
 }
+
+fn reference() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/reference/hex5-lp.json")
+        .display()
+        .to_string()
+}
+
+#[test]
+fn uniformity_on_the_reference_network_reproduces_its_optimum() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "u.json");
+    for solver in ["lp", "bisection"] {
+        let run = ringmesh(&[
+            "uniformity",
+            &reference(),
+            "--solver",
+            solver,
+            "--groups",
+            "front,boundary",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let json: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let ratio = json["ratio"].as_f64().unwrap();
+        assert!((ratio - 20.4503).abs() <= 5e-4, "{solver}: {ratio}");
+        let forces: Vec<f64> = json["tensions"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let max_force = forces.iter().copied().fold(0.0, f64::max);
+        assert!(json["max_residual"].as_f64().unwrap() <= 1e-8 * max_force);
+        assert_eq!(json["q"].as_array().unwrap().len(), 325);
+        for key in ["solver", "termination", "iterations", "time_s"] {
+            assert!(!json[key].is_null(), "{key}");
+        }
+        std::fs::remove_file(&out).unwrap();
+    }
+    assert_rejected(
+        &[
+            "uniformity",
+            &reference(),
+            "--groups",
+            "front,cable",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        "`cable`",
+    );
+}
+
+#[test]
+fn optimize_writes_design_and_cut_lengths() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "opt");
+    let run = ringmesh(&[
+        "optimize",
+        &problem("small-hex.toml"),
+        "--solver",
+        "lp",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let design: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert_eq!(design["scene"], "small-hex");
+    assert_eq!(design["termination"], "converged");
+    let csv = std::fs::read_to_string(out.join("cables.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("id,group,i,j,q,tension_n,length_m,cut_length_m")
+    );
+    // Cut length L0 = ℓ/(1 + T/EA), EA = 50 GPa · π (5 mm)²/4.
+    let ea = 50e9 * std::f64::consts::PI * 0.005f64.powi(2) / 4.0;
+    let mut rows = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let (q, t, l, l0): (f64, f64, f64, f64) = (
+            f[4].parse().unwrap(),
+            f[5].parse().unwrap(),
+            f[6].parse().unwrap(),
+            f[7].parse().unwrap(),
+        );
+        assert!((t - q * l).abs() <= 1e-9 * t);
+        assert!((l0 - l / (1.0 + t / ea)).abs() <= 1e-12 * l);
+        assert!(l0 < l);
+        rows += 1;
+    }
+    assert_eq!(rows, 211);
+}
+
+#[test]
+fn front_writes_csv_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "front");
+    let run = ringmesh(&[
+        "front",
+        &problem("small-hex.toml"),
+        "--solvers",
+        "bisection",
+        "--points",
+        "3",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("front.csv")).unwrap();
+    assert_eq!(csv.lines().next(), Some("solver,knob,ratio,rms_mm,time_s"));
+    assert_eq!(csv.lines().count(), 4);
+    let png = std::fs::read(out.join("front.png")).unwrap();
+    assert_eq!(&png[..4], b"\x89PNG");
+    let svg = std::fs::read_to_string(out.join("front.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("bisection"));
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with('.')
+        })
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
