@@ -9,6 +9,14 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ringmesh::run::Progress;
 use ringmesh::uniformity::SolverKind;
 
+/// Prints a line to stdout; a closed pipe (`ringmesh … | head`) is not an error.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 /// Pretension design of the cable mesh of ring-truss deployable reflectors.
 #[derive(Parser)]
 #[command(name = "ringmesh", version, about, long_about = None)]
@@ -130,15 +138,15 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Mesh { scene, output } => ringmesh::run::mesh(scene, output.as_deref()).map(|m| {
-            println!("scene: {}", m.scene);
-            print!("{}", m.summary);
+            say!("scene: {}", m.scene);
+            say!("{}", m.summary.to_string().trim_end());
             for path in m.written {
-                println!("wrote {}", path.display());
+                say!("wrote {}", path.display());
             }
         }),
         Command::Fdm { network, output } => ringmesh::run::fdm(network, output).map(|o| {
-            println!("max residual: {:.3e} N", o.max_residual);
-            println!("wrote {}", output.display());
+            say!("max residual: {:.3e} N", o.max_residual);
+            say!("wrote {}", output.display());
         }),
         Command::Optimize {
             scene,
@@ -146,25 +154,25 @@ fn main() -> ExitCode {
             output,
         } => ringmesh::run::optimize(scene, *solver, output.as_deref()).map(|(d, written)| {
             for set in &d.sets {
-                println!(
+                say!(
                     "ratio over {}: {:.6} ({} cables)",
                     set.name, set.ratio, set.cables
                 );
             }
-            println!(
+            say!(
                 "surface RMS: {:.3e} mm (max {:.3e} mm)",
                 1e3 * d.surface_rms_m,
                 1e3 * d.surface_max_m
             );
-            println!(
+            say!(
                 "termination: {:?} after {} iterations, {:.3} s",
                 d.termination, d.iterations, d.time_s
             );
             for w in &d.warnings {
-                println!("warning: {w}");
+                say!("warning: {w}");
             }
             for path in written {
-                println!("wrote {}", path.display());
+                say!("wrote {}", path.display());
             }
         }),
         Command::Uniformity {
@@ -175,13 +183,13 @@ fn main() -> ExitCode {
             output,
         } => ringmesh::run::uniformity(network, *solver, groups.as_deref(), *mean_tension, output)
             .map(|o| {
-                println!("ratio: {:.6}", o.ratio);
-                println!("max residual: {:.3e} N", o.max_residual);
-                println!(
+                say!("ratio: {:.6}", o.ratio);
+                say!("max residual: {:.3e} N", o.max_residual);
+                say!(
                     "termination: {:?} after {} iterations, {:.3} s",
                     o.termination, o.iterations, o.time_s
                 );
-                println!("wrote {}", output.display());
+                say!("wrote {}", output.display());
             }),
         Command::Front {
             scene,
@@ -201,15 +209,15 @@ fn main() -> ExitCode {
             result.map(|(points, written)| {
                 for p in &points {
                     match &p.outcome {
-                        Ok(t) => println!(
+                        Ok(t) => say!(
                             "{:?} knob {:.3e}: ratio {:.6}, RMS {:.3e} mm, {:.3} s ({t:?})",
                             p.solver, p.knob, p.ratio, p.rms_mm, p.time_s
                         ),
-                        Err(e) => println!("{:?} knob {:.3e}: failed: {e}", p.solver, p.knob),
+                        Err(e) => say!("{:?} knob {:.3e}: failed: {e}", p.solver, p.knob),
                     }
                 }
                 for path in written {
-                    println!("wrote {}", path.display());
+                    say!("wrote {}", path.display());
                 }
             })
         }
@@ -217,7 +225,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("error: {error}");
+            esay!("error: {error}");
             ExitCode::from(if error.is_bad_input() { 2 } else { 1 })
         }
     }
