@@ -225,7 +225,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            esay!("error: {error}");
+            eprintln!("error: {error}");
             ExitCode::from(if error.is_bad_input() { 2 } else { 1 })
         }
     }
