@@ -1,0 +1,73 @@
+//! Criterion benchmarks of the uniformity solvers.
+//!
+//! * `solver/<name>` — each solver on the realistic 26 m scene with 3, 6 and 10
+//!   front-net rings (the id is the number of cables);
+//! * `bisection_tolerance` — ratio bisection on the small hexagonal scene, the id
+//!   the relative bracket tolerance: what each digit of the ratio costs.
+//!
+//! Run with `cargo bench --bench uniformity`.
+
+use std::path::Path;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use ringmesh::run::scene_problem;
+use ringmesh::uniformity::{Bisection, SolverKind, UniformityProblem, UniformitySolver};
+use ringmesh::Scene;
+
+fn problem(name: &str, rings: Option<usize>) -> UniformityProblem {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("problems/{name}.toml"));
+    let mut scene = Scene::read(&path).expect("shipped scene");
+    if let Some(rings) = rings {
+        scene.front_net.rings = rings;
+        // Dense meshes load the scalloped boundary harder than the shipped bound.
+        scene.cables.max_force_density_n_per_m = 1e9;
+    }
+    scene_problem(&scene).expect("valid scene").1
+}
+
+fn solvers(c: &mut Criterion) {
+    let problems: Vec<UniformityProblem> = [3, 6, 10]
+        .iter()
+        .map(|&r| problem("realistic-26m", Some(r)))
+        .collect();
+    for kind in [
+        SolverKind::Lp,
+        SolverKind::Bisection,
+        SolverKind::Gradient,
+        SolverKind::LeastSquares,
+    ] {
+        let solver = kind.build(None);
+        let mut group = c.benchmark_group(format!("solver/{}", solver.name()));
+        group
+            .sample_size(10)
+            .measurement_time(Duration::from_secs(5));
+        for p in &problems {
+            group.bench_with_input(
+                BenchmarkId::from_parameter(p.network().n_edges()),
+                p,
+                |b, p| b.iter(|| solver.solve(p)),
+            );
+        }
+        group.finish();
+    }
+}
+
+fn bisection_tolerance(c: &mut Criterion) {
+    let p = problem("small-hex", None);
+    let mut group = c.benchmark_group("bisection_tolerance");
+    group.sample_size(10);
+    for tolerance in [1e-2, 1e-4, 1e-6, 1e-8] {
+        let solver = Bisection {
+            relative_tolerance: tolerance,
+            ..Bisection::default()
+        };
+        group.bench_with_input(BenchmarkId::from_parameter(tolerance), &p, |b, p| {
+            b.iter(|| solver.solve(p))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, solvers, bisection_tolerance);
+criterion_main!(benches);
