@@ -156,7 +156,9 @@ fn main() -> ExitCode {
             for set in &d.sets {
                 say!(
                     "ratio over {}: {:.6} ({} cables)",
-                    set.name, set.ratio, set.cables
+                    set.name,
+                    set.ratio,
+                    set.cables
                 );
             }
             say!(
@@ -166,7 +168,9 @@ fn main() -> ExitCode {
             );
             say!(
                 "termination: {:?} after {} iterations, {:.3} s",
-                d.termination, d.iterations, d.time_s
+                d.termination,
+                d.iterations,
+                d.time_s
             );
             for w in &d.warnings {
                 say!("warning: {w}");
@@ -187,7 +191,9 @@ fn main() -> ExitCode {
                 say!("max residual: {:.3e} N", o.max_residual);
                 say!(
                     "termination: {:?} after {} iterations, {:.3} s",
-                    o.termination, o.iterations, o.time_s
+                    o.termination,
+                    o.iterations,
+                    o.time_s
                 );
                 say!("wrote {}", output.display());
             }),
@@ -211,7 +217,11 @@ fn main() -> ExitCode {
                     match &p.outcome {
                         Ok(t) => say!(
                             "{:?} knob {:.3e}: ratio {:.6}, RMS {:.3e} mm, {:.3} s ({t:?})",
-                            p.solver, p.knob, p.ratio, p.rms_mm, p.time_s
+                            p.solver,
+                            p.knob,
+                            p.ratio,
+                            p.rms_mm,
+                            p.time_s
                         ),
                         Err(e) => say!("{:?} knob {:.3e}: failed: {e}", p.solver, p.knob),
                     }
