@@ -39,7 +39,8 @@ fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 /// The knob values swept for `solver`, from accurate to uniform, scaled to the
 /// problem's pretension level `T̄`:
 /// * bisection: ε = 0 (exact equilibrium) and ε from 1e-3·T̄ to T̄, N;
-/// * gradient: ratio weight from 1e-4 to 1e2;
+/// * gradient: ratio weight from 1e-8 to 1 (the surface term is normalised,
+///   so 1e-6 is already near the exact-equilibrium design);
 /// * least squares: λ from 1e-6 to 1e2 (and the equality-constrained limit is
 ///   the `lp`-like exact point, run separately).
 pub fn knob_values(solver: SolverKind, problem: &UniformityProblem, points: usize) -> Vec<f64> {
@@ -51,7 +52,7 @@ pub fn knob_values(solver: SolverKind, problem: &UniformityProblem, points: usiz
             v
         }
         SolverKind::Lp => vec![0.0],
-        SolverKind::Gradient => geometric(1e-4, 1e2, points),
+        SolverKind::Gradient => geometric(1e-8, 1.0, points),
         SolverKind::LeastSquares => geometric(1e-6, 1e2, points),
     }
 }

@@ -20,7 +20,7 @@ mod problem;
 pub use bisection::Bisection;
 pub use design::{Design, TensionSpread, Termination};
 pub use front::{design_front, knob_values, FrontPoint};
-pub use gradient::Gradient;
+pub use gradient::{Gradient, History};
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
 pub use problem::{SurfaceTarget, UniformityProblem, UniformitySet};
