@@ -1,10 +1,17 @@
 //! The baseline: the single-set homogeneous problem as one LP,
 //! `min s` s.t. `A q = 0`, `1 ≤ ℓ_k q_k ≤ s` (k in the set), others
 //! `ℓ_k q_k ≥ f` (f = `min_tension_fraction`), then rescaled to the target mean.
+//!
+//! A reflector mesh's front-net problem is solved as its plan problem
+//! (`plan.rs`) by the structured interior-point method (`ipm.rs`) and completed
+//! with the ties and the rear net; any other network, or a plan solve that does
+//! not reach its tolerance, goes to clarabel on the full problem.
 
 use std::time::Instant;
 
 use super::conic::{infeasible, Class, Cone, ConicProgram};
+use super::ipm::{self, IpmStatus};
+use super::plan::PlanReduction;
 use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
 /// One LP, rescaled. Needs a homogeneous problem (no loads) with one set; the
@@ -37,42 +44,18 @@ impl UniformitySolver for Lp {
         }
         let set = &problem.sets()[0];
         let lengths = problem.lengths_m();
-        let m = problem.network().n_edges();
-        let s = m;
-        let mut program = ConicProgram::new(m + 1);
-        program.equilibrium(problem, 0.0);
-        for &k in &set.edges {
-            program.row(Cone::Nonnegative, &[(k, -lengths[k])], -1.0);
-            program.row(Cone::Nonnegative, &[(k, lengths[k]), (s, -1.0)], 0.0);
-        }
-        for k in problem.other_edges() {
-            program.row(
-                Cone::Nonnegative,
-                &[(k, -lengths[k])],
-                -problem.min_tension_fraction,
-            );
-        }
-        let mut c = vec![0.0; m + 1];
-        c[s] = 1.0;
-        let outcome = program.solve(&c);
-        match outcome.class {
-            Class::Feasible => {}
-            Class::Infeasible => return Err(infeasible(problem)),
-            Class::Failed => {
-                return Err(UniformityError::SolverFailed {
-                    solver: "lp",
-                    status: outcome.status,
-                })
-            }
-        }
-        let mean: f64 = set
-            .edges
-            .iter()
-            .map(|&k| lengths[k] * outcome.x[k])
-            .sum::<f64>()
-            / set.edges.len() as f64;
+        let mut warnings = Vec::new();
+        let (q, iterations) = match PlanReduction::new(problem) {
+            Ok(plan) => solve_plan(&plan, problem, &mut warnings).or_else(|reason| {
+                warnings.push(format!("lp: {reason}; solved the full problem instead"));
+                solve_full(problem, &mut warnings)
+            })?,
+            Err(_) => solve_full(problem, &mut warnings)?,
+        };
+        let mean: f64 =
+            set.edges.iter().map(|&k| lengths[k] * q[k]).sum::<f64>() / set.edges.len() as f64;
         let scale = set.mean_tension_n / mean;
-        let q: Vec<f64> = outcome.x[..m].iter().map(|v| v * scale).collect();
+        let q: Vec<f64> = q.iter().map(|v| v * scale).collect();
         let q_max = q.iter().copied().fold(0.0, f64::max);
         if q_max > problem.max_force_density_n_per_m {
             return Err(UniformityError::Unsupported {
@@ -84,15 +67,130 @@ impl UniformitySolver for Lp {
                 ),
             });
         }
-        let warnings = outcome.warning("lp").into_iter().collect();
         Design::evaluate(
             problem,
             self.name(),
             q,
             Termination::Converged,
-            outcome.iterations,
+            iterations,
             start.elapsed(),
             warnings,
         )
+    }
+}
+
+/// The plan problem (interior point, `plan.rs`), completed with the ties and
+/// the rear net: unscaled `q` and iterations.
+fn solve_plan(
+    plan: &PlanReduction,
+    problem: &UniformityProblem,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<f64>, usize), String> {
+    let solution = ipm::solve(plan.lp()).map_err(|e| e.to_string())?;
+    let [primal, dual, gap] = solution.residuals;
+    match solution.status {
+        IpmStatus::Converged => {}
+        IpmStatus::ReducedAccuracy => warnings.push(format!(
+            "lp: interior point stalled at reduced accuracy (relative primal residual \
+             {primal:.1e}, dual {dual:.1e}, gap {gap:.1e})"
+        )),
+        status => {
+            return Err(format!(
+                "the plan interior-point method stopped with {status:?} (relative primal \
+                 residual {primal:.1e}, dual {dual:.1e}, gap {gap:.1e})"
+            ))
+        }
+    }
+    Ok((plan.complete(problem, &solution.q)?, solution.iterations))
+}
+
+/// The full problem as one conic program (clarabel): every cable, three
+/// equilibrium rows per free node. Unscaled `q` and iterations.
+pub(super) fn solve_full(
+    problem: &UniformityProblem,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<f64>, usize), UniformityError> {
+    let set = &problem.sets()[0];
+    let lengths = problem.lengths_m();
+    let m = problem.network().n_edges();
+    let s = m;
+    let mut program = ConicProgram::new(m + 1);
+    program.equilibrium(problem, 0.0);
+    for &k in &set.edges {
+        program.row(Cone::Nonnegative, &[(k, -lengths[k])], -1.0);
+        program.row(Cone::Nonnegative, &[(k, lengths[k]), (s, -1.0)], 0.0);
+    }
+    for k in problem.other_edges() {
+        program.row(
+            Cone::Nonnegative,
+            &[(k, -lengths[k])],
+            -problem.min_tension_fraction,
+        );
+    }
+    let mut c = vec![0.0; m + 1];
+    c[s] = 1.0;
+    let outcome = program.solve(&c);
+    match outcome.class {
+        Class::Feasible => {
+            warnings.extend(outcome.warning("lp"));
+            Ok((outcome.x[..m].to_vec(), outcome.iterations))
+        }
+        Class::Infeasible => Err(infeasible(problem)),
+        Class::Failed => Err(UniformityError::SolverFailed {
+            solver: "lp",
+            status: outcome.status,
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uniformity::ipm::tests::set_ratio;
+
+    /// The plan path (interior point on two rows per front node, then the ties
+    /// and the rear net) and clarabel on the full problem find the same optimum,
+    /// and the completed `q` balances every free node of both nets.
+    fn plan_matches_full(path: &str) {
+        let scene = crate::Scene::read(std::path::Path::new(path)).expect("scene");
+        let problem = crate::run::scene_problem(&scene).expect("problem").1;
+        let plan = PlanReduction::new(&problem).expect("a reflector mesh");
+        let network = problem.network();
+        let ties = (0..network.n_edges())
+            .filter(|&k| network.group_of(k) == "tie")
+            .count();
+        assert_eq!(plan.lp().n_free, ties, "one plan node per tie");
+        let (q_plan, _) = solve_plan(&plan, &problem, &mut Vec::new()).expect("plan");
+        let (q_full, _) = solve_full(&problem, &mut Vec::new()).expect("full");
+        let (plan_ratio, full_ratio) = (set_ratio(&problem, &q_plan), set_ratio(&problem, &q_full));
+        assert!(
+            (plan_ratio - full_ratio).abs() <= 1e-6 * full_ratio,
+            "{plan_ratio} vs {full_ratio}"
+        );
+        let max_tension = q_plan
+            .iter()
+            .zip(problem.lengths_m())
+            .map(|(q, l)| q * l)
+            .fold(0.0, f64::max);
+        let residual = problem.prescribed_residual_n(&q_plan);
+        assert!(
+            residual <= 1e-9 * max_tension,
+            "{residual} vs {max_tension}"
+        );
+    }
+
+    #[test]
+    fn plan_matches_full_small_hex() {
+        plan_matches_full("problems/small-hex.toml");
+    }
+
+    #[test]
+    fn plan_matches_full_small_offset() {
+        plan_matches_full("problems/small-offset.toml");
+    }
+
+    #[test]
+    fn plan_matches_full_paper_26m() {
+        plan_matches_full("problems/paper-26m.toml");
     }
 }

@@ -13,8 +13,10 @@ mod conic;
 mod design;
 mod front;
 mod gradient;
+mod ipm;
 mod least_squares;
 mod lp;
+mod plan;
 mod problem;
 
 pub use bisection::Bisection;
