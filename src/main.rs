@@ -91,6 +91,9 @@ enum Command {
         /// Target mean tension of those cables, N [default: that of the file's q].
         #[arg(long)]
         mean_tension: Option<f64>,
+        /// Upper bound [q] on every force density, N/m [default: none].
+        #[arg(long)]
+        max_force_density: Option<f64>,
         /// Output JSON file.
         #[arg(short, long)]
         output: PathBuf,
@@ -184,19 +187,27 @@ fn main() -> ExitCode {
             solver,
             groups,
             mean_tension,
+            max_force_density,
             output,
-        } => ringmesh::run::uniformity(network, *solver, groups.as_deref(), *mean_tension, output)
-            .map(|o| {
-                say!("ratio: {:.6}", o.ratio);
-                say!("max residual: {:.3e} N", o.max_residual);
-                say!(
-                    "termination: {:?} after {} iterations, {:.3} s",
-                    o.termination,
-                    o.iterations,
-                    o.time_s
-                );
-                say!("wrote {}", output.display());
-            }),
+        } => ringmesh::run::uniformity(
+            network,
+            *solver,
+            groups.as_deref(),
+            *mean_tension,
+            max_force_density.unwrap_or(f64::INFINITY),
+            output,
+        )
+        .map(|o| {
+            say!("ratio: {:.6}", o.ratio);
+            say!("max residual: {:.3e} N", o.max_residual);
+            say!(
+                "termination: {:?} after {} iterations, {:.3} s",
+                o.termination,
+                o.iterations,
+                o.time_s
+            );
+            say!("wrote {}", output.display());
+        }),
         Command::Front {
             scene,
             solvers,

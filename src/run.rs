@@ -164,12 +164,14 @@ pub struct UniformityOutput {
 /// `ringmesh uniformity`: the uniformity problem on a network whose node
 /// positions are the prescribed geometry. `groups`: the uniformity set is their
 /// union (default `front` when the file has groups, else every cable);
-/// `mean_tension_n`: its target (default: the mean tension of the file's `q`).
+/// `mean_tension_n`: its target (default: the mean tension of the file's `q`);
+/// `max_force_density_n_per_m`: the bound `[q]` on every cable (may be infinite).
 pub fn uniformity(
     network_path: &Path,
     solver: SolverKind,
     groups: Option<&[String]>,
     mean_tension_n: Option<f64>,
+    max_force_density_n_per_m: f64,
     output_path: &Path,
 ) -> Result<UniformityOutput, Error> {
     let network = Network::read_json(network_path)?;
@@ -219,7 +221,7 @@ pub fn uniformity(
         vec![set],
         surface,
         SurfaceTarget::Prescribed,
-        f64::INFINITY,
+        max_force_density_n_per_m,
     )?;
     let design = solver.build(None).solve(&problem)?;
     let output = UniformityOutput {

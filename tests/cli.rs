@@ -169,6 +169,59 @@ fn reference() -> String {
         .to_string()
 }
 
+/// The gradient solver on a network file, without and with a bound `[q]`: a
+/// finite design within 5 % of the LP optimum of the prescribed geometry (its
+/// geometry is free, so it may also land a little below), every `q` positive
+/// and within the bound.
+#[test]
+fn uniformity_gradient_on_a_network_file_respects_the_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "g.json");
+    for bound in [None, Some("1000")] {
+        let mut args = vec![
+            "uniformity",
+            "REF",
+            "--solver",
+            "gradient",
+            "--groups",
+            "front,boundary",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        let reference = reference();
+        args[1] = &reference;
+        if let Some(b) = bound {
+            args.extend(["--max-force-density", b]);
+        }
+        let run = ringmesh(&args);
+        assert!(
+            run.status.success(),
+            "{bound:?}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let json: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let ratio = json["ratio"].as_f64().unwrap();
+        assert!((ratio / 20.4503 - 1.0).abs() <= 0.05, "{bound:?}: {ratio}");
+        let limit: f64 = bound.map_or(f64::INFINITY, |b| b.parse().unwrap());
+        for q in json["q"].as_array().unwrap() {
+            let q = q.as_f64().unwrap();
+            assert!(q > 0.0 && q <= limit, "{bound:?}: q = {q}");
+        }
+        std::fs::remove_file(&out).unwrap();
+    }
+    assert_rejected(
+        &[
+            "uniformity",
+            &reference(),
+            "--max-force-density=-1",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        "maximum force density",
+    );
+}
+
 #[test]
 fn uniformity_on_the_reference_network_reproduces_its_optimum() {
     let dir = tempfile::tempdir().unwrap();

@@ -390,38 +390,66 @@ impl UniformitySolver for Gradient {
     }
 }
 
-/// The smooth bijection `θ ↦ q = q_0 + ([q] − q_0) σ(θ)` onto `(q_0, [q])`.
+/// The smooth bijection `θ ↦ q = q_0 + ([q] − q_0) σ(θ)` onto `(q_0, [q])`, or
+/// `θ ↦ e^θ` onto `(0, ∞)` when there is no bound.
 #[derive(Debug, Clone, Copy)]
-struct Map {
-    floor: f64,
-    span: f64,
+enum Map {
+    /// `q = q_0 + ([q] − q_0) σ(θ)` for a finite bound `[q]`.
+    Bounded { floor: f64, span: f64 },
+    /// `q = e^θ` when there is no bound.
+    Log,
 }
 
 impl Map {
     fn new(problem: &UniformityProblem) -> Self {
         let q_max = problem.max_force_density_n_per_m;
-        let floor = FLOOR_FRACTION * q_max;
-        Map {
-            floor,
-            span: q_max - floor,
+        if q_max.is_finite() {
+            let floor = FLOOR_FRACTION * q_max;
+            Map::Bounded {
+                floor,
+                span: q_max - floor,
+            }
+        } else {
+            Map::Log
+        }
+    }
+
+    /// The smallest `q` the map reaches, `q_0` (or the smallest positive float).
+    fn floor(&self) -> f64 {
+        match *self {
+            Map::Bounded { floor, .. } => floor,
+            Map::Log => f64::MIN_POSITIVE,
         }
     }
 
     /// `q(θ)`.
     fn q(&self, theta: f64) -> f64 {
-        self.floor + self.span * sigmoid(theta)
+        match *self {
+            Map::Bounded { floor, span } => floor + span * sigmoid(theta),
+            Map::Log => theta.exp(),
+        }
     }
 
-    /// `dq/dθ = ([q] − q_0) σ (1 − σ)`.
+    /// `dq/dθ`: `([q] − q_0) σ (1 − σ)`, or `e^θ`.
     fn dq(&self, theta: f64) -> f64 {
-        let s = sigmoid(theta);
-        self.span * s * (1.0 - s)
+        match *self {
+            Map::Bounded { span, .. } => {
+                let s = sigmoid(theta);
+                span * s * (1.0 - s)
+            }
+            Map::Log => theta.exp(),
+        }
     }
 
-    /// `θ(q)`, with `q` clamped a hair inside `(q_0, [q])`.
+    /// `θ(q)`, with `q` clamped a hair inside `(q_0, [q])` (or above 0).
     fn theta(&self, q: f64) -> f64 {
-        let s = ((q - self.floor) / self.span).clamp(1e-300, 1.0 - 1e-12);
-        s.ln() - (-s).ln_1p()
+        match *self {
+            Map::Bounded { floor, span } => {
+                let s = ((q - floor) / span).clamp(1e-300, 1.0 - 1e-12);
+                s.ln() - (-s).ln_1p()
+            }
+            Map::Log => q.max(f64::MIN_POSITIVE).ln(),
+        }
     }
 }
 
@@ -713,7 +741,7 @@ impl Preconditioner {
         let factor = factor_k(&edges, &edges_vectors, &freedom, n_rows, g)?;
         Ok(Preconditioner {
             q_ref,
-            floor: Map::new(problem).floor,
+            floor: Map::new(problem).floor(),
             upper,
             freedom,
             edges_vectors,
