@@ -3,7 +3,12 @@
 //! * `solver/<name>` — each solver on the realistic 26 m scene with 3, 6 and 10
 //!   front-net rings (the id is the number of cables);
 //! * `bisection_tolerance` — ratio bisection on the small hexagonal scene, the id
-//!   the relative bracket tolerance: what each digit of the ratio costs.
+//!   the relative bracket tolerance: what each digit of the ratio costs;
+//! * `lp_nodes` — the `lp` optimum of the paper scene (30 bays) with its front net
+//!   refined to ~10³, 10⁴ and 3·10⁴ net nodes (the id is the node count, front +
+//!   rear); `RINGMESH_BENCH_RINGS=57` adds a ~10⁵-node net;
+//! * `gradient_nodes` — the `gradient` solver on the paper scene with 3 rings
+//!   (362 net nodes).
 //!
 //! Run with `cargo bench --bench uniformity`.
 
@@ -12,7 +17,9 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use ringmesh::run::scene_problem;
-use ringmesh::uniformity::{Bisection, SolverKind, UniformityProblem, UniformitySolver};
+use ringmesh::uniformity::{
+    Bisection, Gradient, Lp, SolverKind, UniformityProblem, UniformitySolver,
+};
 use ringmesh::Scene;
 
 fn problem(name: &str, rings: Option<usize>) -> UniformityProblem {
@@ -69,5 +76,47 @@ fn bisection_tolerance(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, solvers, bisection_tolerance);
+fn lp_nodes(c: &mut Criterion) {
+    let mut rings = vec![4, 18, 32];
+    if let Ok(extra) = std::env::var("RINGMESH_BENCH_RINGS") {
+        rings.extend(
+            extra
+                .split(',')
+                .filter_map(|r| r.trim().parse::<usize>().ok()),
+        );
+    }
+    let mut group = c.benchmark_group("lp_nodes");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    for r in rings {
+        let p = problem("paper-26m", Some(r));
+        group.bench_with_input(
+            BenchmarkId::from_parameter(p.network().n_nodes()),
+            &p,
+            |b, p| b.iter(|| Lp.solve(p)),
+        );
+    }
+    group.finish();
+}
+
+fn gradient_nodes(c: &mut Criterion) {
+    let p = problem("paper-26m", Some(3));
+    let mut group = c.benchmark_group("gradient_nodes");
+    group.sample_size(10);
+    group.bench_with_input(
+        BenchmarkId::from_parameter(p.network().n_nodes()),
+        &p,
+        |b, p| b.iter(|| Gradient::default().solve(p)),
+    );
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    solvers,
+    bisection_tolerance,
+    lp_nodes,
+    gradient_nodes
+);
 criterion_main!(benches);
