@@ -866,22 +866,26 @@ impl Program {
             // Predictor.
             let rxz: Vec<f64> = x.iter().zip(&z).map(|(a, b)| -a * b).collect();
             let rwl: Vec<f64> = w.iter().zip(&lam).map(|(a, b)| -a * b).collect();
-            let affine = self.direction(
-                normal,
-                &sc,
-                &x,
-                &z,
-                &w,
-                &lam,
-                &Rhs {
-                    rp: &rp,
-                    rw: &rw,
-                    rd: &rd,
-                    rs,
-                    rxz: &rxz,
-                    rwl: &rwl,
-                },
-            );
+            // Both directions share the factor and differ in the complementarity rows.
+            let mut direction = |rxz: &[f64], rwl: &[f64]| {
+                self.direction(
+                    normal,
+                    &sc,
+                    &x,
+                    &z,
+                    &w,
+                    &lam,
+                    &Rhs {
+                        rp: &rp,
+                        rw: &rw,
+                        rd: &rd,
+                        rs,
+                        rxz,
+                        rwl,
+                    },
+                )
+            };
+            let affine = direction(&rxz, &rwl);
             let ap = max_step(&x, &affine.dx).min(max_step(&w, &affine.dw));
             let ad = max_step(&z, &affine.dz).min(max_step(&lam, &affine.dlam));
             let mu_aff = ((0..m)
@@ -900,22 +904,7 @@ impl Program {
             let rwl: Vec<f64> = (0..p)
                 .map(|j| sigma * mu - w[j] * lam[j] - affine.dw[j] * affine.dlam[j])
                 .collect();
-            let d = self.direction(
-                normal,
-                &sc,
-                &x,
-                &z,
-                &w,
-                &lam,
-                &Rhs {
-                    rp: &rp,
-                    rw: &rw,
-                    rd: &rd,
-                    rs,
-                    rxz: &rxz,
-                    rwl: &rwl,
-                },
-            );
+            let d = direction(&rxz, &rwl);
             let eta = (1.0 - mu.min(0.1)).clamp(0.9, 0.99995);
             let ap = (eta * max_step(&x, &d.dx).min(max_step(&w, &d.dw))).min(1.0);
             let ad = (eta * max_step(&z, &d.dz).min(max_step(&lam, &d.dlam))).min(1.0);
