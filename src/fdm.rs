@@ -18,7 +18,7 @@ use faer::{Conj, Mat, MatMut, Par, Side};
 use crate::network::{edges_vectors, norm3, Network, NetworkError};
 
 /// Marks "no such index" in the dense index maps below.
-const NONE: usize = usize::MAX;
+pub(crate) const NONE: usize = usize::MAX;
 
 /// Parallelism of the numeric factorisation and solves. Sequential: on the
 /// 2-core reference machine faer's parallel supernodal factorisation of a
@@ -81,9 +81,9 @@ impl FdmError {
 /// the diagonal slots of `i` and `j` (if free) and the off-diagonal slot (if both
 /// are free).
 #[derive(Debug, Clone, Copy)]
-struct EdgeSlots {
-    diagonal: [usize; 2],
-    off_diagonal: usize,
+pub(crate) struct EdgeSlots {
+    pub(crate) diagonal: [usize; 2],
+    pub(crate) off_diagonal: usize,
 }
 
 /// The topology of a network as the force density method needs it: free/fixed
@@ -326,7 +326,7 @@ impl FdmStructure {
 
 /// Builds the lower-triangular sparsity of `D` (diagonal first in each column,
 /// rows ascending) and each cable's value slots in it.
-fn d_sparsity(
+pub(crate) fn d_sparsity(
     edges: &[[usize; 2]],
     free_index: &[usize],
     n_free: usize,

@@ -41,13 +41,11 @@ use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
 use super::UniformityError;
-
-/// Marks "no such index" (a fixed end of a cable, a cable outside the set).
-const NONE: usize = usize::MAX;
+use crate::fdm::{d_sparsity, NONE};
 
 /// Relative tolerance on the dual residual and the duality gap.
 const TOLERANCE: f64 = 1e-9;
@@ -161,59 +159,31 @@ impl<const D: usize> NormalMatrix<D> {
             .map(|e| e.map(|i| i.unwrap_or(NONE)))
             .collect();
 
-        // Node graph: for each free node, its free neighbours with a larger index.
-        let pair = |&[a, b]: &[usize; 2]| (a != NONE && b != NONE).then(|| (a.min(b), a.max(b)));
-        let mut nb_ptr = vec![0usize; n_free + 1];
-        for (lo, _) in ends.iter().filter_map(pair) {
-            nb_ptr[lo + 1] += 1;
-        }
-        for f in 0..n_free {
-            nb_ptr[f + 1] += nb_ptr[f];
-        }
-        let mut nb = vec![0usize; nb_ptr[n_free]];
-        let mut fill = nb_ptr.clone();
-        for (lo, hi) in ends.iter().filter_map(pair) {
-            nb[fill[lo]] = hi;
-            fill[lo] += 1;
-        }
-        let mut compact = vec![0usize; n_free + 1];
-        let mut write = 0;
-        for f in 0..n_free {
-            let list = &mut nb[nb_ptr[f]..nb_ptr[f + 1]];
-            list.sort_unstable();
-            let mut previous = NONE;
-            for read in nb_ptr[f]..nb_ptr[f + 1] {
-                let r = nb[read];
-                if r != previous {
-                    nb[write] = r;
-                    write += 1;
-                    previous = r;
-                }
-            }
-            compact[f + 1] = write;
-        }
-        nb.truncate(write);
+        // The node graph is the pattern of `D = C_fᵀ Q C_f` (lower triangle, the
+        // diagonal first in each column); a fixed end maps to an extra node that
+        // is not free.
+        let free_index: Vec<usize> = (0..n_free).chain([NONE]).collect();
+        let node_edges: Vec<[usize; 2]> = ends
+            .iter()
+            .map(|e| e.map(|i| if i == NONE { n_free } else { i }))
+            .collect();
+        let (graph, slots) = d_sparsity(&node_edges, &free_index, n_free);
+        let (graph_ptr, graph_idx) = (graph.col_ptr(), graph.row_idx());
+        // A cable between free nodes: its place among the neighbours of its lower end.
         let neighbour = ends
             .iter()
-            .map(|e| match pair(e) {
-                Some((lo, hi)) => nb[compact[lo]..compact[lo + 1]]
-                    .binary_search(&hi)
-                    .expect("neighbour is listed"),
-                None => NONE,
+            .zip(&slots)
+            .map(|(&[a, b], slot)| {
+                if a == NONE || b == NONE {
+                    NONE
+                } else {
+                    slot.off_diagonal - graph_ptr[a.min(b)] - 1
+                }
             })
             .collect();
+        let neighbours = |f: usize| &graph_idx[graph_ptr[f] + 1..graph_ptr[f + 1]];
 
-        // Fill-reducing ordering of the node graph (pattern of D, lower triangle
-        // with the diagonal), expanded to the D×D blocks.
-        let mut graph_ptr = vec![0usize; n_free + 1];
-        let mut graph_idx = Vec::with_capacity(n_free + nb.len());
-        for f in 0..n_free {
-            graph_idx.push(f);
-            graph_idx.extend_from_slice(&nb[compact[f]..compact[f + 1]]);
-            graph_ptr[f + 1] = graph_idx.len();
-        }
-        let graph =
-            SymbolicSparseColMatRef::new_checked(n_free, n_free, &graph_ptr, None, &graph_idx);
+        // Fill-reducing ordering of the node graph, expanded to the D×D blocks.
         let mut perm = vec![0usize; n_free];
         let mut perm_inv = vec![0usize; n_free];
         {
@@ -222,7 +192,7 @@ impl<const D: usize> NormalMatrix<D> {
             amd::order(
                 &mut perm,
                 &mut perm_inv,
-                graph,
+                graph.as_ref(),
                 amd::Control::default(),
                 MemStack::new(&mut mem),
             )
@@ -235,7 +205,7 @@ impl<const D: usize> NormalMatrix<D> {
         // then the D rows of each neighbour block, ascending.
         let mut col_ptr = vec![0usize; n_rows + 1];
         for f in 0..n_free {
-            let n_nb = compact[f + 1] - compact[f];
+            let n_nb = neighbours(f).len();
             for c in 0..D {
                 col_ptr[D * f + c + 1] = col_ptr[D * f + c] + (D - c) + D * n_nb;
             }
@@ -244,7 +214,7 @@ impl<const D: usize> NormalMatrix<D> {
         for f in 0..n_free {
             for c in 0..D {
                 row_idx.extend(D * f + c..D * f + D);
-                for &r in &nb[compact[f]..compact[f + 1]] {
+                for &r in neighbours(f) {
                     row_idx.extend(D * r..D * r + D);
                 }
             }
