@@ -24,6 +24,7 @@
 
 pub mod fdm;
 pub mod geometry;
+pub mod mechanics;
 pub mod network;
 pub mod report;
 pub mod run;

@@ -1,0 +1,299 @@
+//! Sparse assembly of the residual and the consistent tangent of a [`Model`],
+//! joints by Lagrange multipliers, and their solution (faer sparse LU).
+//!
+//! Unknowns: the free components of every node's increment `(δx, δθ)` (fixed
+//! components are eliminated), then one multiplier per joint equation. The
+//! equations are scaled by a stiffness `s` so that the saddle-point matrix
+//!
+//! ```text
+//! ⎡ K + s Σ μ ∂²g   s Gᵀ ⎤
+//! ⎣ s G              0   ⎦
+//! ```
+//!
+//! stays balanced for thin tubes (EA·L²/EI up to 1e8). The sparsity pattern and
+//! the symbolic LU are computed once; each Newton iteration refills values in
+//! the same order and refactors numerically.
+
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::{Mat, MatMut};
+use rayon::prelude::*;
+
+use super::beam::Frame;
+use super::joint::ConstraintRow;
+use super::model::{MechanicsError, Model};
+
+/// Index of a fixed component.
+const FIXED: usize = usize::MAX;
+
+/// The assembled problem's structure: dof numbering, pattern, symbolic LU.
+pub(crate) struct System {
+    /// Global unknown of node n's component c (or `FIXED`).
+    dof: Vec<[usize; 6]>,
+    pub n_free: usize,
+    /// First multiplier row of each joint.
+    joint_row: Vec<usize>,
+    pub n_rows: usize,
+    /// Constraint scaling `s`, N/m.
+    pub scale: f64,
+    pattern: Vec<Pair<usize, usize>>,
+    symbolic: SymbolicSparseColMat<usize>,
+    argsort: Argsort<usize>,
+    lu: SymbolicLu<usize>,
+}
+
+/// The state of the unknowns: node frames and scaled multipliers.
+#[derive(Debug, Clone)]
+pub struct State {
+    /// Every node's position and rotation.
+    pub frames: Vec<Frame>,
+    /// Joint multipliers (scaled by the system's stiffness scale).
+    pub(crate) multipliers: Vec<f64>,
+}
+
+/// Residual and tangent values at a state.
+pub(crate) struct Evaluation {
+    /// Residual of every unknown (forces, moments, joint equations).
+    pub residual: Vec<f64>,
+    /// Tangent values in pattern order.
+    pub values: Vec<f64>,
+    /// Residual of every fixed component: the support reactions, per node.
+    pub reactions: Vec<[f64; 6]>,
+    /// Largest internal nodal force component of any element (roundoff scale).
+    pub internal_scale: f64,
+}
+
+impl System {
+    /// The structure of `model`.
+    pub fn new(model: &Model) -> Result<Self, MechanicsError> {
+        let mut dof = vec![[FIXED; 6]; model.node_count()];
+        let mut n_free = 0;
+        for (n, d) in dof.iter_mut().enumerate() {
+            for (c, slot) in d.iter_mut().enumerate().take(model.node_dofs[n]) {
+                if !model.fixed[n][c] {
+                    *slot = n_free;
+                    n_free += 1;
+                }
+            }
+        }
+        let mut joint_row = Vec::with_capacity(model.joints.len());
+        let mut n_rows = n_free;
+        for j in &model.joints {
+            joint_row.push(n_rows);
+            n_rows += j.rows();
+        }
+        // Constraint scale: the stiffest element's axial stiffness EA/L.
+        let scale = model
+            .elements
+            .iter()
+            .map(|e| e.axial_stiffness())
+            .fold(0.0, f64::max)
+            .max(1.0);
+
+        let mut pattern = Vec::new();
+        let block = |a: usize, b: usize, pattern: &mut Vec<Pair<usize, usize>>| {
+            for &i in dof[a].iter().filter(|&&i| i != FIXED) {
+                for &j in dof[b].iter().filter(|&&j| j != FIXED) {
+                    pattern.push(Pair { row: i, col: j });
+                }
+            }
+        };
+        for e in &model.elements {
+            for a in e.nodes {
+                for b in e.nodes {
+                    block(a, b, &mut pattern);
+                }
+            }
+        }
+        for (k, j) in model.joints.iter().enumerate() {
+            for a in j.nodes {
+                for b in j.nodes {
+                    block(a, b, &mut pattern);
+                }
+            }
+            for r in 0..j.rows() {
+                let row = joint_row[k] + r;
+                for n in j.nodes {
+                    for &i in dof[n].iter().filter(|&&i| i != FIXED) {
+                        pattern.push(Pair { row, col: i });
+                        pattern.push(Pair { row: i, col: row });
+                    }
+                }
+            }
+        }
+        // Every diagonal entry, so that the pattern is structurally square.
+        pattern.extend((0..n_rows).map(|i| Pair { row: i, col: i }));
+
+        let (symbolic, argsort) =
+            SymbolicSparseColMat::try_new_from_indices(n_rows, n_rows, &pattern).map_err(|e| {
+                MechanicsError::Mechanism {
+                    detail: format!("sparsity pattern: {e:?}"),
+                }
+            })?;
+        let lu = SymbolicLu::try_new(symbolic.as_ref()).map_err(|e| MechanicsError::Mechanism {
+            detail: format!("symbolic LU: {e:?}"),
+        })?;
+        Ok(System {
+            dof,
+            n_free,
+            joint_row,
+            n_rows,
+            scale,
+            pattern,
+            symbolic,
+            argsort,
+            lu,
+        })
+    }
+
+    /// The reference state: reference frames, zero multipliers.
+    pub fn reference_state(&self, model: &Model) -> State {
+        State {
+            frames: model.reference.clone(),
+            multipliers: vec![0.0; self.n_rows - self.n_free],
+        }
+    }
+
+    /// Residual `F = f_int + s Gᵀμ − λ f_ext` (free components), `s g` (joint
+    /// rows), and the tangent values, at `state` and load factor `lambda`.
+    pub fn evaluate(&self, model: &Model, state: &State, lambda: f64) -> Evaluation {
+        let n_nodes = model.node_count();
+        let mut full = vec![[0.0f64; 6]; n_nodes];
+        let mut values = Vec::with_capacity(self.pattern.len());
+        let element_terms: Vec<_> = model
+            .elements
+            .par_iter()
+            .map(|e| {
+                let [a, b] = e.nodes;
+                e.residual_tangent([&state.frames[a], &state.frames[b]])
+            })
+            .collect();
+        let mut internal_scale = 0.0f64;
+        for (e, (r, k)) in model.elements.iter().zip(&element_terms) {
+            internal_scale = internal_scale.max(r.amax());
+            for (slot, &n) in e.nodes.iter().enumerate() {
+                for c in 0..6 {
+                    full[n][c] += r[6 * slot + c];
+                }
+            }
+            for sa in 0..2 {
+                for sb in 0..2 {
+                    let (a, b) = (e.nodes[sa], e.nodes[sb]);
+                    for ca in (0..6).filter(|&c| self.dof[a][c] != FIXED) {
+                        for cb in (0..6).filter(|&c| self.dof[b][c] != FIXED) {
+                            values.push(k[(6 * sa + ca, 6 * sb + cb)]);
+                        }
+                    }
+                }
+            }
+        }
+
+        let mut residual = vec![0.0; self.n_rows];
+        let mut rows: Vec<ConstraintRow> = Vec::new();
+        let s = self.scale;
+        for (k, j) in model.joints.iter().enumerate() {
+            let [a, b] = j.nodes;
+            j.evaluate([&state.frames[a], &state.frames[b]], &mut rows);
+            let first = self.joint_row[k] - self.n_free;
+            // Tangent: s Σ μ ∂²g on the rotation blocks.
+            for sa in 0..2 {
+                for sb in 0..2 {
+                    let (na, nb) = (j.nodes[sa], j.nodes[sb]);
+                    for ca in (0..6).filter(|&c| self.dof[na][c] != FIXED) {
+                        for cb in (0..6).filter(|&c| self.dof[nb][c] != FIXED) {
+                            let mut v = 0.0;
+                            if ca >= 3 && cb >= 3 {
+                                for (r, row) in rows.iter().enumerate() {
+                                    v += state.multipliers[first + r]
+                                        * row.curvature[sa][sb][(ca - 3, cb - 3)];
+                                }
+                            }
+                            values.push(s * v);
+                        }
+                    }
+                }
+            }
+            for (r, row) in rows.iter().enumerate() {
+                let mu = state.multipliers[first + r];
+                residual[self.joint_row[k] + r] = s * row.value;
+                for (slot, &n) in j.nodes.iter().enumerate() {
+                    for c in 0..6 {
+                        full[n][c] += s * mu * row.gradient[6 * slot + c];
+                    }
+                    for c in (0..6).filter(|&c| self.dof[n][c] != FIXED) {
+                        let g = s * row.gradient[6 * slot + c];
+                        values.push(g);
+                        values.push(g);
+                    }
+                }
+            }
+        }
+        values.extend(std::iter::repeat_n(0.0, self.n_rows));
+
+        for l in &model.loads {
+            for c in 0..3 {
+                full[l.node][c] -= lambda * l.force_n[c];
+                full[l.node][3 + c] -= lambda * l.moment_nm[c];
+            }
+        }
+        let mut reactions = vec![[0.0; 6]; n_nodes];
+        for n in 0..n_nodes {
+            for c in 0..model.node_dofs[n] {
+                match self.dof[n][c] {
+                    FIXED => reactions[n][c] = full[n][c],
+                    i => residual[i] = full[n][c],
+                }
+            }
+        }
+        debug_assert_eq!(values.len(), self.pattern.len());
+        Evaluation {
+            residual,
+            values,
+            reactions,
+            internal_scale,
+        }
+    }
+
+    /// Factor the tangent with `values` (pattern order).
+    pub fn factor(&self, values: &[f64]) -> Result<Lu<usize, f64>, String> {
+        let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
+            .map_err(|e| format!("{e:?}"))?;
+        Lu::try_new_with_symbolic(self.lu.clone(), matrix.as_ref()).map_err(|e| format!("{e:?}"))
+    }
+
+    /// Solve `J Δ = rhs` in place with a factor of the tangent.
+    pub fn solve_in_place(lu: &Lu<usize, f64>, rhs: MatMut<'_, f64>) {
+        use faer::linalg::solvers::SolveCore;
+        lu.solve_in_place_with_conj(faer::Conj::No, rhs);
+    }
+
+    /// Apply the increment `delta` (unknown order) to `state`:
+    /// `x ← x + δx`, `R ← exp(δθ̃) R`, `μ ← μ + δμ`.
+    pub fn apply(&self, state: &mut State, delta: &[f64], step: f64) {
+        for (n, frame) in state.frames.iter_mut().enumerate() {
+            let d = |c: usize| match self.dof[n][c] {
+                FIXED => 0.0,
+                i => step * delta[i],
+            };
+            frame.position_m += nalgebra::Vector3::new(d(0), d(1), d(2));
+            let theta = nalgebra::Vector3::new(d(3), d(4), d(5));
+            if theta != nalgebra::Vector3::zeros() {
+                frame.rotation = super::rotation::exp(&theta) * frame.rotation;
+                frame.rotation.renormalize();
+            }
+        }
+        for (mu, d) in state.multipliers.iter_mut().zip(&delta[self.n_free..]) {
+            *mu += step * d;
+        }
+    }
+
+    /// The free unknown of node `n`'s component `c`, if not fixed.
+    pub fn unknown(&self, n: usize, c: usize) -> Option<usize> {
+        (self.dof[n][c] != FIXED).then_some(self.dof[n][c])
+    }
+
+    /// A column vector of the unknowns' size.
+    pub fn column(&self, values: &[f64]) -> Mat<f64> {
+        Mat::from_fn(self.n_rows, 1, |i, _| values[i])
+    }
+}

@@ -1,0 +1,26 @@
+//! A multibody statics engine for frames of geometrically exact rods, rigid
+//! bodies and joints (paper §3, DESIGN §5): the ring truss is one such frame.
+//!
+//! * [`rotation`] — SO(3): exponential, logarithm, tangent operator (eq. 7–14);
+//! * [`beam`] — the 2-node beam elements: Crisfield–Jelenić (eq. 17–21) and SE(3);
+//! * [`joint`] — fixed, revolute and spherical joints as constraints (eq. 22–25);
+//! * [`model`] — nodes, rods, bodies, joints, supports, loads: a validated frame;
+//! * [`statics`] — Newton–Raphson with adaptive load stepping, and
+//!   arc-length continuation (`arc_length`) through limit points.
+
+mod arc_length;
+mod assembly;
+pub mod cantilever;
+pub mod beam;
+pub mod joint;
+pub mod model;
+pub mod rotation;
+pub mod statics;
+
+pub use assembly::State;
+pub use beam::{ElementKind, Frame, Section};
+pub use joint::JointKind;
+pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, Rod, RodSpec};
+pub use statics::{
+    PathControl, StaticSettings, StaticSolution, StaticSolver, StaticTermination, StepRecord,
+};

@@ -1,0 +1,371 @@
+//! A frame model: nodes (6-DOF frames or 3-DOF points), rods meshed into beam
+//! elements, rigid bodies, joints, supports and dead loads, built once and
+//! validated, then solved by [`super::statics`].
+//!
+//! A rigid body (paper §3.3) is a 6-DOF node with no element of its own: its
+//! marker points (eq. 22) are the offsets at which joints and loads act.
+
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+
+use super::beam::{BeamElement, ElementKind, Frame, Section};
+use super::joint::{Joint, JointKind};
+
+/// Index of a node in a [`Model`].
+pub type NodeId = usize;
+
+/// A model that cannot be built; every variant names the item at fault.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum MechanicsError {
+    /// An item of the model is invalid.
+    #[error("{item}: {reason}")]
+    Invalid {
+        /// The item: `rod 3`, `joint 7`, `node 12`, `support 0`, `load 2`.
+        item: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The tangent of the reference configuration is singular: the frame is a
+    /// mechanism (a rigid-body mode or a free joint rotation is not restrained).
+    #[error("the frame is a mechanism: its stiffness matrix is singular ({detail})")]
+    Mechanism {
+        /// Where it was detected.
+        detail: String,
+    },
+}
+
+impl MechanicsError {
+    pub(crate) fn invalid(item: impl Into<String>, reason: impl Into<String>) -> Self {
+        MechanicsError::Invalid {
+            item: item.into(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// A dead nodal load at the reference load factor 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodalLoad {
+    /// The node.
+    pub node: NodeId,
+    /// Force, N (spatial, fixed in direction).
+    pub force_n: Vector3<f64>,
+    /// Moment, N·m (spatial, fixed in direction).
+    pub moment_nm: Vector3<f64>,
+}
+
+/// How a rod is meshed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodSpec {
+    /// Section stiffnesses.
+    pub section: Section,
+    /// Number of elements (≥ 1).
+    pub elements: usize,
+    /// Element type.
+    pub kind: ElementKind,
+}
+
+/// The nodes of a meshed rod, start to end.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rod {
+    /// Node ids along the rod (elements + 1).
+    pub nodes: Vec<NodeId>,
+}
+
+impl Rod {
+    /// The start node.
+    pub fn start(&self) -> NodeId {
+        self.nodes[0]
+    }
+    /// The end node.
+    pub fn end(&self) -> NodeId {
+        *self.nodes.last().expect("a rod has at least two nodes")
+    }
+}
+
+/// A built and validated frame model.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub(crate) reference: Vec<Frame>,
+    /// Degrees of freedom per node: 6 (frame) or 3 (point).
+    pub(crate) node_dofs: Vec<usize>,
+    pub(crate) elements: Vec<BeamElement>,
+    pub(crate) joints: Vec<Joint>,
+    /// Fixed components per node: translations x, y, z, rotations about x, y, z.
+    pub(crate) fixed: Vec<[bool; 6]>,
+    pub(crate) loads: Vec<NodalLoad>,
+    /// The element each rod starts with, and the rods' node lists.
+    pub(crate) rods: Vec<Rod>,
+}
+
+impl Model {
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.reference.len()
+    }
+    /// Number of beam elements.
+    pub fn element_count(&self) -> usize {
+        self.elements.len()
+    }
+    /// Number of joints.
+    pub fn joint_count(&self) -> usize {
+        self.joints.len()
+    }
+    /// The rods, in the order they were added.
+    pub fn rods(&self) -> &[Rod] {
+        &self.rods
+    }
+    /// The reference configuration of every node.
+    pub fn reference(&self) -> &[Frame] {
+        &self.reference
+    }
+    /// The dead loads at load factor 1.
+    pub fn loads(&self) -> &[NodalLoad] {
+        &self.loads
+    }
+    /// Replace the dead loads (the structure and its factorisation pattern stay).
+    ///
+    /// # Errors
+    /// A load on a node that does not exist, a moment on a 3-DOF point, or a
+    /// non-finite component.
+    pub fn set_loads(&mut self, loads: Vec<NodalLoad>) -> Result<(), MechanicsError> {
+        for (i, l) in loads.iter().enumerate() {
+            check_load(i, l, &self.node_dofs)?;
+        }
+        self.loads = loads;
+        Ok(())
+    }
+}
+
+fn check_load(i: usize, l: &NodalLoad, node_dofs: &[usize]) -> Result<(), MechanicsError> {
+    let item = format!("load {i}");
+    let Some(&dofs) = node_dofs.get(l.node) else {
+        return Err(MechanicsError::invalid(item, format!("node {} does not exist", l.node)));
+    };
+    if !(l.force_n.iter().chain(l.moment_nm.iter()).all(|v| v.is_finite())) {
+        return Err(MechanicsError::invalid(item, "a component is not finite"));
+    }
+    if dofs == 3 && l.moment_nm != Vector3::zeros() {
+        return Err(MechanicsError::invalid(
+            item,
+            format!("node {} is a point (no rotation): it takes no moment", l.node),
+        ));
+    }
+    Ok(())
+}
+
+/// Builds a [`Model`] item by item; [`ModelBuilder::build`] validates it.
+#[derive(Debug, Default, Clone)]
+pub struct ModelBuilder {
+    reference: Vec<Frame>,
+    node_dofs: Vec<usize>,
+    elements: Vec<BeamElement>,
+    joints: Vec<(JointKind, NodeId, NodeId, Vector3<f64>)>,
+    fixed: Vec<[bool; 6]>,
+    loads: Vec<NodalLoad>,
+    rods: Vec<Rod>,
+    errors: Vec<MechanicsError>,
+}
+
+impl ModelBuilder {
+    /// An empty model.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A 6-DOF node (a rigid body, or a rod's node) at `position_m` with
+    /// orientation `rotation`. Returns its id.
+    pub fn add_frame(&mut self, position_m: Vector3<f64>, rotation: UnitQuaternion<f64>) -> NodeId {
+        self.push_node(Frame { position_m, rotation }, 6)
+    }
+
+    /// A rigid body (paper §3.3) at `position_m`, axes along the global axes.
+    pub fn add_body(&mut self, position_m: Vector3<f64>) -> NodeId {
+        self.add_frame(position_m, UnitQuaternion::identity())
+    }
+
+    /// A 3-DOF point (a cable node): position only.
+    pub fn add_point(&mut self, position_m: Vector3<f64>) -> NodeId {
+        self.push_node(Frame { position_m, rotation: UnitQuaternion::identity() }, 3)
+    }
+
+    fn push_node(&mut self, frame: Frame, dofs: usize) -> NodeId {
+        if !frame.position_m.iter().all(|v| v.is_finite()) {
+            self.errors.push(MechanicsError::invalid(
+                format!("node {}", self.reference.len()),
+                "position is not finite",
+            ));
+        }
+        self.reference.push(frame);
+        self.node_dofs.push(dofs);
+        self.fixed.push([false; 6]);
+        self.reference.len() - 1
+    }
+
+    /// A straight rod from `start_m` to `end_m`, meshed into `spec.elements`
+    /// elements with their own nodes (joints connect its end nodes to bodies).
+    /// The material frame has its first axis along the rod and its second
+    /// axis as close to `up` as possible (any vector not along the rod).
+    pub fn add_rod(
+        &mut self,
+        start_m: Vector3<f64>,
+        end_m: Vector3<f64>,
+        up: Vector3<f64>,
+        spec: &RodSpec,
+    ) -> Rod {
+        let item = format!("rod {}", self.rods.len());
+        let axis = end_m - start_m;
+        let length = axis.norm();
+        if spec.elements == 0 {
+            self.errors.push(MechanicsError::invalid(&item, "needs at least one element"));
+        }
+        if let Some(field) = spec.section.invalid_field() {
+            self.errors.push(MechanicsError::invalid(
+                &item,
+                format!("section stiffness {field} must be finite and positive"),
+            ));
+        }
+        if !(length.is_finite() && length > 0.0) {
+            self.errors
+                .push(MechanicsError::invalid(&item, "start and end coincide (zero length)"));
+            self.rods.push(Rod { nodes: vec![] });
+            return self.rods.last().cloned().expect("just pushed");
+        }
+        let rotation = rod_frame(&axis, &up);
+        let elements = spec.elements.max(1);
+        let nodes: Vec<NodeId> = (0..=elements)
+            .map(|i| {
+                let s = i as f64 / elements as f64;
+                self.add_frame(start_m + axis * s, rotation)
+            })
+            .collect();
+        for w in nodes.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let element = BeamElement::new(
+                spec.kind,
+                [a, b],
+                [&self.reference[a], &self.reference[b]],
+                &spec.section,
+            );
+            self.elements.push(element);
+        }
+        let rod = Rod { nodes };
+        self.rods.push(rod.clone());
+        rod
+    }
+
+    /// A joint between nodes `a` and `b` at the point `at_m` of the reference
+    /// configuration: [`JointKind::Fixed`] (6 equations, eq. 24) or
+    /// [`JointKind::Revolute`] about a global reference axis (5 equations, eq. 25),
+    /// or [`JointKind::Spherical`] (3 equations: the point only).
+    pub fn add_joint(&mut self, kind: JointKind, a: NodeId, b: NodeId, at_m: Vector3<f64>) {
+        self.joints.push((kind, a, b, at_m));
+    }
+
+    /// Fix components of node `node`: `[x, y, z, θx, θy, θz]` (global axes).
+    pub fn fix(&mut self, node: NodeId, components: [bool; 6]) {
+        match self.fixed.get_mut(node) {
+            Some(f) => {
+                for (slot, c) in f.iter_mut().zip(components) {
+                    *slot |= c;
+                }
+            }
+            None => self.errors.push(MechanicsError::invalid(
+                format!("support on node {node}"),
+                "the node does not exist",
+            )),
+        }
+    }
+
+    /// A dead load at node `node` (scaled by the load factor).
+    pub fn add_load(&mut self, node: NodeId, force_n: Vector3<f64>, moment_nm: Vector3<f64>) {
+        self.loads.push(NodalLoad { node, force_n, moment_nm });
+    }
+
+    /// The reference configuration of a node added so far.
+    pub fn frame(&self, node: NodeId) -> Option<&Frame> {
+        self.reference.get(node)
+    }
+
+    /// Validate and build.
+    ///
+    /// # Errors
+    /// The first invalid item, named: a zero-length rod, a joint on a missing
+    /// node or between a node and itself, a rotational joint on a point, a
+    /// load on a missing node.
+    pub fn build(mut self) -> Result<Model, MechanicsError> {
+        if let Some(e) = self.errors.drain(..).next() {
+            return Err(e);
+        }
+        let mut joints = Vec::with_capacity(self.joints.len());
+        for (j, &(kind, a, b, at)) in self.joints.iter().enumerate() {
+            let item = format!("joint {j}");
+            for n in [a, b] {
+                if n >= self.reference.len() {
+                    return Err(MechanicsError::invalid(item, format!("node {n} does not exist")));
+                }
+            }
+            if a == b {
+                return Err(MechanicsError::invalid(item, format!("joins node {a} to itself")));
+            }
+            if !at.iter().all(|v| v.is_finite()) {
+                return Err(MechanicsError::invalid(item, "its point is not finite"));
+            }
+            let rotational = !matches!(kind, JointKind::Spherical);
+            for n in [a, b] {
+                if self.node_dofs[n] == 3 && rotational {
+                    return Err(MechanicsError::invalid(
+                        item,
+                        format!("node {n} is a point: it has no rotation to join"),
+                    ));
+                }
+                if self.node_dofs[n] == 3 && (self.reference[n].position_m - at).norm() > 0.0 {
+                    return Err(MechanicsError::invalid(
+                        item,
+                        format!("node {n} is a point: the joint must be at its position"),
+                    ));
+                }
+            }
+            if let JointKind::Revolute { axis } = kind {
+                if !(axis.norm().is_finite() && axis.norm() > 0.0) {
+                    return Err(MechanicsError::invalid(item, "revolute axis must be a non-zero vector"));
+                }
+            }
+            joints.push(Joint::new(kind, [a, b], [&self.reference[a], &self.reference[b]], at));
+        }
+        for (n, f) in self.fixed.iter_mut().enumerate() {
+            if self.node_dofs[n] == 3 {
+                f[3..].iter_mut().for_each(|c| *c = true);
+            }
+        }
+        for (i, l) in self.loads.iter().enumerate() {
+            check_load(i, l, &self.node_dofs)?;
+        }
+        Ok(Model {
+            reference: self.reference,
+            node_dofs: self.node_dofs,
+            elements: self.elements,
+            joints,
+            fixed: self.fixed,
+            loads: self.loads,
+            rods: self.rods,
+        })
+    }
+}
+
+/// The material frame of a rod: first axis along `axis`, second as close to
+/// `up` as possible (or to a global axis, when `up` is along the rod).
+pub fn rod_frame(axis: &Vector3<f64>, up: &Vector3<f64>) -> UnitQuaternion<f64> {
+    let e1 = axis.normalize();
+    let mut helper = *up - e1 * e1.dot(up);
+    if helper.norm() < 1e-8 * up.norm().max(1.0) {
+        // Any axis the rod is least aligned with.
+        let k = e1.iamin();
+        let mut g = Vector3::zeros();
+        g[k] = 1.0;
+        helper = g - e1 * e1.dot(&g);
+    }
+    let e2 = helper.normalize();
+    let e3 = e1.cross(&e2);
+    let m = Matrix3::from_columns(&[e1, e2, e3]);
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m))
+}
