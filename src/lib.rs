@@ -29,6 +29,7 @@ pub mod network;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod truss;
 pub mod uniformity;
 
 pub use fdm::{Equilibrium, FdmError, FdmStructure};

@@ -112,6 +112,19 @@ pub struct Truss {
     /// The supports.
     #[serde(default)]
     pub supports: Supports,
+    /// Beam elements per rod of the flexible truss models (1…64).
+    #[serde(default = "default_elements_per_rod")]
+    pub elements_per_rod: usize,
+    /// Beam element of the flexible truss models.
+    #[serde(default)]
+    pub element: crate::mechanics::ElementKind,
+}
+
+/// Largest number of beam elements per truss rod.
+pub const MAX_ELEMENTS_PER_ROD: usize = 64;
+
+fn default_elements_per_rod() -> usize {
+    4
 }
 
 /// The front net: sector subdivision of the N-gon of top hinges.
@@ -304,6 +317,12 @@ impl Scene {
             ));
         }
         positive("truss.height_m", t.height_m)?;
+        if !(1..=MAX_ELEMENTS_PER_ROD).contains(&t.elements_per_rod) {
+            return Err(SceneError::invalid(
+                "truss.elements_per_rod",
+                format!("{} must be in 1…{MAX_ELEMENTS_PER_ROD}", t.elements_per_rod),
+            ));
+        }
         positive("truss.tube_outer_diameter_m", t.tube_outer_diameter_m)?;
         non_negative("truss.tube_inner_diameter_m", t.tube_inner_diameter_m)?;
         if t.tube_inner_diameter_m >= t.tube_outer_diameter_m {

@@ -52,7 +52,11 @@ fn weights(solver: &StaticSolver, system: &System) -> Vec<f64> {
 }
 
 fn wdot(w: &[f64], a: &[f64], b: &[f64]) -> f64 {
-    w.iter().zip(a).zip(b).map(|((w, a), b)| w * w * a * b).sum()
+    w.iter()
+        .zip(a)
+        .zip(b)
+        .map(|((w, a), b)| w * w * a * b)
+        .sum()
 }
 
 pub(crate) fn follow(
@@ -80,20 +84,26 @@ pub(crate) fn follow(
 
     let termination = loop {
         if steps.len() >= settings.max_steps || attempts > 4 * settings.max_steps {
-            break StaticTermination::MaxSteps { load_factor: lambda };
+            break StaticTermination::MaxSteps {
+                load_factor: lambda,
+            };
         }
         attempts += 1;
         // Predictor: tangent direction at the converged state.
         let ev = system.evaluate(solver.model(), &state, lambda);
         let Ok(lu) = system.factor(&ev.values) else {
-            break StaticTermination::Stalled { load_factor: lambda };
+            break StaticTermination::Stalled {
+                load_factor: lambda,
+            };
         };
         let mut t = Mat::from_fn(n, 1, |i, _| f_hat[i]);
         System::solve_in_place(&lu, t.as_mut());
         let tangent: Vec<f64> = (0..n).map(|i| t[(i, 0)]).collect();
         let tn = wdot(&w, &tangent, &tangent).sqrt();
         if !(tn.is_finite() && tn > 0.0) {
-            break StaticTermination::Stalled { load_factor: lambda };
+            break StaticTermination::Stalled {
+                load_factor: lambda,
+            };
         }
         let dl = *arc.get_or_insert(settings.initial_step * tn);
         let sign = match &previous {
@@ -111,20 +121,15 @@ pub(crate) fn follow(
         let mut residuals = Vec::new();
         let mut converged = false;
         let mut iterations = 0;
-        let load_scale = f_hat.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for it in 0..=settings.max_iterations {
             let ev = system.evaluate(solver.model(), &trial, trial_lambda);
-            let force = ev.residual[..system.n_free].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let gap = ev.residual[system.n_free..].iter().fold(0.0f64, |m, v| m.max(v.abs())) / system.scale;
+            let (force, ok) = solver.converged(&ev, trial_lambda, settings);
             residuals.push(force);
             iterations = it;
-            if !(force.is_finite() && gap.is_finite()) {
+            if !force.is_finite() {
                 break;
             }
-            let reaction_scale = ev.reactions.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-            let tol = (settings.tolerance * (load_scale * trial_lambda.abs()).max(reaction_scale))
-                .max(64.0 * f64::EPSILON * ev.internal_scale);
-            if force <= tol && gap <= settings.tolerance * solver.length_scale() {
+            if ok {
                 converged = true;
                 reactions = ev.reactions;
                 break;
@@ -132,8 +137,11 @@ pub(crate) fn follow(
             if it == settings.max_iterations {
                 break;
             }
-            let Ok(lu) = system.factor(&ev.values) else { break };
-            let mut rhs = Mat::from_fn(n, 2, |i, j| if j == 0 { -ev.residual[i] } else { f_hat[i] });
+            let Ok(lu) = system.factor(&ev.values) else {
+                break;
+            };
+            let mut rhs =
+                Mat::from_fn(n, 2, |i, j| if j == 0 { -ev.residual[i] } else { f_hat[i] });
             System::solve_in_place(&lu, rhs.as_mut());
             let du_f: Vec<f64> = (0..n).map(|i| rhs[(i, 0)]).collect();
             let du_t: Vec<f64> = (0..n).map(|i| rhs[(i, 1)]).collect();
@@ -146,7 +154,10 @@ pub(crate) fn follow(
             if !(disc >= 0.0 && a1 > 0.0) {
                 break;
             }
-            let roots = [(-a2 + disc.sqrt()) / (2.0 * a1), (-a2 - disc.sqrt()) / (2.0 * a1)];
+            let roots = [
+                (-a2 + disc.sqrt()) / (2.0 * a1),
+                (-a2 - disc.sqrt()) / (2.0 * a1),
+            ];
             // The root that keeps the step's direction.
             let d_lambda = roots
                 .into_iter()
@@ -158,7 +169,11 @@ pub(crate) fn follow(
                     score(*x).total_cmp(&score(*y))
                 })
                 .expect("two roots");
-            let delta: Vec<f64> = du_f.iter().zip(&du_t).map(|(f, t)| f + d_lambda * t).collect();
+            let delta: Vec<f64> = du_f
+                .iter()
+                .zip(&du_t)
+                .map(|(f, t)| f + d_lambda * t)
+                .collect();
             system.apply(&mut trial, &delta, 1.0);
             for (a, d) in increment.iter_mut().zip(&delta) {
                 *a += d;
@@ -172,18 +187,27 @@ pub(crate) fn follow(
             let cut = arc.map(|a| a * 0.25).unwrap_or(0.0);
             arc = Some(cut);
             if cut < settings.min_step * tn {
-                break StaticTermination::Stalled { load_factor: lambda };
+                break StaticTermination::Stalled {
+                    load_factor: lambda,
+                };
             }
             continue;
         }
         if trial_lambda > 1.0 && lambda < 1.0 {
             // Land exactly on λ = 1 by load control from the last state below it.
             let mut landing = state.clone();
-            let run_settings = StaticSettings { initial_step: 1.0, ..settings.clone() };
-            let landed = solver.solve_from(landing.clone(), lambda, &StaticSettings {
-                path: super::statics::PathControl::Load,
-                ..run_settings
-            });
+            let run_settings = StaticSettings {
+                initial_step: 1.0,
+                ..settings.clone()
+            };
+            let landed = solver.solve_from(
+                landing.clone(),
+                lambda,
+                &StaticSettings {
+                    path: super::statics::PathControl::Load,
+                    ..run_settings
+                },
+            );
             if let Ok(sol) = landed {
                 newton_iterations += sol.newton_iterations;
                 if sol.converged() {
@@ -201,23 +225,33 @@ pub(crate) fn follow(
         state = trial;
         lambda = trial_lambda;
         lambda_max = lambda_max.max(lambda);
-        steps.push(StepRecord { load_factor: lambda, iterations, residuals });
+        steps.push(StepRecord {
+            load_factor: lambda,
+            iterations,
+            residuals,
+        });
         if (lambda - 1.0).abs() <= settings.tolerance {
             break StaticTermination::Converged;
         }
         if lambda < lambda_max - 1e-12 && lambda <= lambda0 {
             // The path has come back below its start: the limit load was passed
             // and the structure unloads.
-            break StaticTermination::LimitPoint { limit_load_factor: lambda_max };
+            break StaticTermination::LimitPoint {
+                limit_load_factor: lambda_max,
+            };
         }
-        let factor = (TARGET_ITERATIONS / iterations.max(1) as f64).sqrt().clamp(0.25, 2.0);
+        let factor = (TARGET_ITERATIONS / iterations.max(1) as f64)
+            .sqrt()
+            .clamp(0.25, 2.0);
         arc = arc.map(|a| a * factor);
     };
     let termination = match termination {
         StaticTermination::MaxSteps { .. } | StaticTermination::Stalled { .. }
             if lambda_max > lambda + 1e-12 =>
         {
-            StaticTermination::LimitPoint { limit_load_factor: lambda_max }
+            StaticTermination::LimitPoint {
+                limit_load_factor: lambda_max,
+            }
         }
         t => t,
     };

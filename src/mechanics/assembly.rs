@@ -217,8 +217,8 @@ impl System {
                 let mu = state.multipliers[first + r];
                 residual[self.joint_row[k] + r] = s * row.value;
                 for (slot, &n) in j.nodes.iter().enumerate() {
-                    for c in 0..6 {
-                        full[n][c] += s * mu * row.gradient[6 * slot + c];
+                    for (f, g) in full[n].iter_mut().zip(&row.gradient[6 * slot..6 * slot + 6]) {
+                        *f += s * mu * g;
                     }
                     for c in (0..6).filter(|&c| self.dof[n][c] != FIXED) {
                         let g = s * row.gradient[6 * slot + c];

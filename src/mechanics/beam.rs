@@ -23,13 +23,12 @@ use num_dual::{hessian, DualNum};
 use serde::{Deserialize, Serialize};
 
 use super::rotation::{
-    exp_generic, exp_second_order, lift_m, lift_v, log_generic, mat_mat, mat_t_mat,
-    mat_t_vec, mat_vec, scale, sub, left_jacobian_inverse_generic, M3, V3,
+    exp_generic, exp_second_order, left_jacobian_inverse_generic, lift_m, lift_v, log_generic,
+    mat_mat, mat_t_mat, mat_t_vec, mat_vec, scale, sub, M3, V3,
 };
 
 /// Which beam element a rod is meshed with.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[derive(clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum ElementKind {
     /// Helicoidal interpolation on SE(3): strains from the logarithm of the
@@ -100,7 +99,14 @@ impl Section {
 
     /// The first invalid stiffness (`"axial_n"`, …), if any is not finite and positive.
     pub fn invalid_field(&self) -> Option<&'static str> {
-        let names = ["axial_n", "shear_n", "shear_n", "torsion_nm2", "bending_nm2", "bending_nm2"];
+        let names = [
+            "axial_n",
+            "shear_n",
+            "shear_n",
+            "torsion_nm2",
+            "bending_nm2",
+            "bending_nm2",
+        ];
         self.diagonal()
             .iter()
             .zip(names)
@@ -145,9 +151,7 @@ impl Configuration {
 
     /// Positions and rotations perturbed by `ξ = (δx_A, δθ_A, δx_B, δθ_B)`.
     fn perturbed<S: DualNum<f64> + Copy>(&self, xi: &[S; 12]) -> ([V3<S>; 2], [M3<S>; 2]) {
-        let x = std::array::from_fn(|n| {
-            std::array::from_fn(|c| xi[6 * n + c] + self.x[n][c])
-        });
+        let x = std::array::from_fn(|n| std::array::from_fn(|c| xi[6 * n + c] + self.x[n][c]));
         let r = std::array::from_fn(|n| {
             let e = exp_second_order(&[xi[6 * n + 3], xi[6 * n + 4], xi[6 * n + 5]]);
             let rn: M3<S> = self.r[n].map(|row| row.map(S::from));
@@ -226,9 +230,9 @@ impl BeamElement {
         let (x, r) = c.perturbed(xi);
         let e = strains(self.kind, self.length_m, &x, &r);
         let mut w = S::zero();
-        for k in 0..6 {
-            let d = e[k] - self.reference_strain[k];
-            w += d * d * self.stiffness[k];
+        for ((e, e0), c) in e.iter().zip(&self.reference_strain).zip(&self.stiffness) {
+            let d = *e - *e0;
+            w += d * d * *c;
         }
         w * (0.5 * self.length_m)
     }
@@ -239,20 +243,17 @@ impl BeamElement {
     }
 
     /// Strain energy at `frames`, J.
+    #[cfg(test)]
     pub fn strain_energy(&self, frames: [&Frame; 2]) -> f64 {
         self.energy(&Configuration::of(frames), &[0.0; 12])
     }
 
-    /// Strains minus reference strains, `(Γ − Γ₀, K − K₀)`.
-    pub fn strain(&self, frames: [&Frame; 2]) -> [f64; 6] {
-        let c = Configuration::of(frames);
-        let e = strains(self.kind, self.length_m, &c.x, &c.r);
-        std::array::from_fn(|k| e[k] - self.reference_strain[k])
-    }
-
     /// Residual (internal nodal forces and spatial moments, 12) and consistent
     /// tangent (12 × 12) at `frames`.
-    pub fn residual_tangent(&self, frames: [&Frame; 2]) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+    pub fn residual_tangent(
+        &self,
+        frames: [&Frame; 2],
+    ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
         let c = Configuration::of(frames);
         let (_, r, mut k) = hessian(
             |xi: SVector<_, 12>| {
@@ -287,7 +288,10 @@ mod tests {
     /// A bent, twisted, stretched element far from its straight reference.
     fn deformed(kind: ElementKind) -> (BeamElement, [Frame; 2]) {
         let rot = exp(&Vector3::new(0.1, -0.2, 0.3));
-        let a0 = Frame { position_m: Vector3::new(0.0, 0.0, 0.0), rotation: rot };
+        let a0 = Frame {
+            position_m: Vector3::new(0.0, 0.0, 0.0),
+            rotation: rot,
+        };
         let b0 = Frame {
             position_m: Vector3::new(0.0, 0.0, 0.0) + rot * Vector3::new(0.7, 0.0, 0.0),
             rotation: rot,
@@ -328,8 +332,13 @@ mod tests {
                 let h = 1e-6;
                 let p = perturb(&frames, i, h);
                 let m = perturb(&frames, i, -h);
-                let fd = (e.strain_energy([&p[0], &p[1]]) - e.strain_energy([&m[0], &m[1]])) / (2.0 * h);
-                assert!((fd - r[i]).abs() < 1e-6 * scale, "{kind:?} dof {i}: {fd} vs {}", r[i]);
+                let fd =
+                    (e.strain_energy([&p[0], &p[1]]) - e.strain_energy([&m[0], &m[1]])) / (2.0 * h);
+                assert!(
+                    (fd - r[i]).abs() < 1e-6 * scale,
+                    "{kind:?} dof {i}: {fd} vs {}",
+                    r[i]
+                );
             }
         }
     }
@@ -364,8 +373,14 @@ mod tests {
         for kind in [ElementKind::Se3, ElementKind::CrisfieldJelenic] {
             let (e, _) = deformed(kind);
             let rot = exp(&Vector3::new(0.1, -0.2, 0.3));
-            let a = Frame { position_m: Vector3::zeros(), rotation: rot };
-            let b = Frame { position_m: rot * Vector3::new(0.7, 0.0, 0.0), rotation: rot };
+            let a = Frame {
+                position_m: Vector3::zeros(),
+                rotation: rot,
+            };
+            let b = Frame {
+                position_m: rot * Vector3::new(0.7, 0.0, 0.0),
+                rotation: rot,
+            };
             let (r, _) = e.residual_tangent([&a, &b]);
             assert!(r.amax() < 1e-9, "{kind:?}: {}", r.amax());
         }

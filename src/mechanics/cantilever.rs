@@ -68,29 +68,51 @@ pub struct CantileverRow {
 
 /// The cantilever of `elements` elements of `kind`, clamped at the origin,
 /// axis along x, tip moment `M` about z (bending in the x–y plane).
-pub fn model(elements: usize, kind: ElementKind, moment_nm: f64) -> Result<StaticSolver, MechanicsError> {
+pub fn model(
+    elements: usize,
+    kind: ElementKind,
+    moment_nm: f64,
+) -> Result<StaticSolver, MechanicsError> {
     let mut b = ModelBuilder::new();
     let rod = b.add_rod(
         Vector3::zeros(),
         Vector3::new(LENGTH_M, 0.0, 0.0),
         Vector3::y(),
-        &RodSpec { section: section(), elements, kind },
+        &RodSpec {
+            section: section(),
+            elements,
+            kind,
+        },
     );
     b.fix(rod.start(), [true; 6]);
-    b.add_load(rod.end(), Vector3::zeros(), Vector3::new(0.0, 0.0, moment_nm));
+    b.add_load(
+        rod.end(),
+        Vector3::zeros(),
+        Vector3::new(0.0, 0.0, moment_nm),
+    );
     StaticSolver::new(b.build()?)
 }
 
 /// Solve one load of the table.
-pub fn row(elements: usize, kind: ElementKind, m_ratio: f64, settings: &StaticSettings) -> Result<CantileverRow, MechanicsError> {
+pub fn row(
+    elements: usize,
+    kind: ElementKind,
+    m_ratio: f64,
+    settings: &StaticSettings,
+) -> Result<CantileverRow, MechanicsError> {
     let moment = m_ratio * std::f64::consts::PI * BENDING_NM2 / LENGTH_M;
     let solver = model(elements, kind, moment)?;
     let solution = solver.solve(settings)?;
-    let tip = solution.state.frames.last().expect("a rod has nodes").position_m;
+    let tip = solution
+        .state
+        .frames
+        .last()
+        .expect("a rod has nodes")
+        .position_m;
     let (axial_m, vertical_m) = (LENGTH_M - tip.x, tip.y);
     let (ax, ve) = analytic(m_ratio);
-    let relative_error = ((axial_m - ax).powi(2) + (vertical_m - ve).powi(2)).sqrt()
-        / (ax * ax + ve * ve).sqrt();
+    let relative_error =
+        ((axial_m - ax).powi(2) + (vertical_m - ve).powi(2)).sqrt() / (ax * ax + ve * ve).sqrt();
     Ok(CantileverRow {
         m_ratio,
         axial_m,
@@ -108,5 +130,8 @@ pub fn row(elements: usize, kind: ElementKind, m_ratio: f64, settings: &StaticSe
 /// The whole table (every load of [`M_RATIOS`]).
 pub fn table(elements: usize, kind: ElementKind) -> Result<Vec<CantileverRow>, MechanicsError> {
     let settings = StaticSettings::default();
-    M_RATIOS.iter().map(|&m| row(elements, kind, m, &settings)).collect()
+    M_RATIOS
+        .iter()
+        .map(|&m| row(elements, kind, m, &settings))
+        .collect()
 }

@@ -35,7 +35,6 @@ pub enum JointKind {
 /// A built joint: local markers and directors of each node.
 #[derive(Debug, Clone)]
 pub(crate) struct Joint {
-    pub kind: JointKind,
     pub nodes: [usize; 2],
     /// Marker offsets in each node's material frame.
     markers: [Vector3<f64>; 2],
@@ -55,9 +54,13 @@ pub(crate) struct ConstraintRow {
 }
 
 impl Joint {
-    pub fn new(kind: JointKind, nodes: [usize; 2], frames: [&Frame; 2], at_m: Vector3<f64>) -> Self {
-        let markers =
-            frames.map(|f| f.rotation.inverse() * (at_m - f.position_m));
+    pub fn new(
+        kind: JointKind,
+        nodes: [usize; 2],
+        frames: [&Frame; 2],
+        at_m: Vector3<f64>,
+    ) -> Self {
+        let markers = frames.map(|f| f.rotation.inverse() * (at_m - f.position_m));
         let local = |v: Vector3<f64>| frames.map(|f| f.rotation.inverse() * v);
         let directors = match kind {
             JointKind::Fixed => {
@@ -78,7 +81,11 @@ impl Joint {
             }
             JointKind::Spherical => vec![],
         };
-        Joint { kind, nodes, markers, directors }
+        Joint {
+            nodes,
+            markers,
+            directors,
+        }
     }
 
     /// Number of equations.
@@ -166,15 +173,28 @@ mod tests {
     #[test]
     fn gradients_and_curvatures_match_differences() {
         let reference = [
-            Frame { position_m: Vector3::zeros(), rotation: UnitQuaternion::identity() },
-            Frame { position_m: Vector3::new(1.0, 0.0, 0.0), rotation: exp(&Vector3::new(0.0, 0.0, 0.5)) },
+            Frame {
+                position_m: Vector3::zeros(),
+                rotation: UnitQuaternion::identity(),
+            },
+            Frame {
+                position_m: Vector3::new(1.0, 0.0, 0.0),
+                rotation: exp(&Vector3::new(0.0, 0.0, 0.5)),
+            },
         ];
         for kind in [
             JointKind::Fixed,
-            JointKind::Revolute { axis: Vector3::new(0.3, 1.0, 0.2) },
+            JointKind::Revolute {
+                axis: Vector3::new(0.3, 1.0, 0.2),
+            },
             JointKind::Spherical,
         ] {
-            let joint = Joint::new(kind, [0, 1], [&reference[0], &reference[1]], Vector3::new(0.4, 0.3, 0.0));
+            let joint = Joint::new(
+                kind,
+                [0, 1],
+                [&reference[0], &reference[1]],
+                Vector3::new(0.4, 0.3, 0.0),
+            );
             let f = frames();
             let mut rows = vec![];
             joint.evaluate([&f[0], &f[1]], &mut rows);
@@ -187,7 +207,10 @@ mod tests {
                 joint.evaluate([&m[0], &m[1]], &mut rm);
                 for (k, row) in rows.iter().enumerate() {
                     let fd = (rp[k].value - rm[k].value) / (2.0 * h);
-                    assert!((fd - row.gradient[j]).abs() < 1e-8, "{kind:?} row {k} dof {j}");
+                    assert!(
+                        (fd - row.gradient[j]).abs() < 1e-8,
+                        "{kind:?} row {k} dof {j}"
+                    );
                     // Derivative of the rotational gradient along rotation dof j.
                     if j % 6 >= 3 {
                         let (nb, cj) = (j / 6, j % 6 - 3);
@@ -196,7 +219,10 @@ mod tests {
                                 let i = 6 * na + 3 + ci;
                                 let fd = (rp[k].gradient[i] - rm[k].gradient[i]) / (2.0 * h);
                                 let an = row.curvature[na][nb][(ci, cj)];
-                                assert!((fd - an).abs() < 1e-7, "{kind:?} row {k} ∂g[{i}]/∂θ[{j}]: {fd} vs {an}");
+                                assert!(
+                                    (fd - an).abs() < 1e-7,
+                                    "{kind:?} row {k} ∂g[{i}]/∂θ[{j}]: {fd} vs {an}"
+                                );
                             }
                         }
                     }
@@ -208,11 +234,22 @@ mod tests {
     #[test]
     fn reference_configuration_satisfies_every_joint() {
         let reference = [
-            Frame { position_m: Vector3::zeros(), rotation: exp(&Vector3::new(0.2, 0.1, 0.0)) },
-            Frame { position_m: Vector3::new(1.0, 2.0, 0.0), rotation: exp(&Vector3::new(0.0, 0.0, 0.5)) },
+            Frame {
+                position_m: Vector3::zeros(),
+                rotation: exp(&Vector3::new(0.2, 0.1, 0.0)),
+            },
+            Frame {
+                position_m: Vector3::new(1.0, 2.0, 0.0),
+                rotation: exp(&Vector3::new(0.0, 0.0, 0.5)),
+            },
         ];
         for kind in [JointKind::Fixed, JointKind::Revolute { axis: Vector3::z() }] {
-            let joint = Joint::new(kind, [0, 1], [&reference[0], &reference[1]], Vector3::new(0.5, 0.5, 0.5));
+            let joint = Joint::new(
+                kind,
+                [0, 1],
+                [&reference[0], &reference[1]],
+                Vector3::new(0.5, 0.5, 0.5),
+            );
             let mut rows = vec![];
             joint.evaluate([&reference[0], &reference[1]], &mut rows);
             assert!(rows.iter().all(|r| r.value.abs() < 1e-15));

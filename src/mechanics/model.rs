@@ -139,15 +139,26 @@ impl Model {
 fn check_load(i: usize, l: &NodalLoad, node_dofs: &[usize]) -> Result<(), MechanicsError> {
     let item = format!("load {i}");
     let Some(&dofs) = node_dofs.get(l.node) else {
-        return Err(MechanicsError::invalid(item, format!("node {} does not exist", l.node)));
+        return Err(MechanicsError::invalid(
+            item,
+            format!("node {} does not exist", l.node),
+        ));
     };
-    if !(l.force_n.iter().chain(l.moment_nm.iter()).all(|v| v.is_finite())) {
+    if !(l
+        .force_n
+        .iter()
+        .chain(l.moment_nm.iter())
+        .all(|v| v.is_finite()))
+    {
         return Err(MechanicsError::invalid(item, "a component is not finite"));
     }
     if dofs == 3 && l.moment_nm != Vector3::zeros() {
         return Err(MechanicsError::invalid(
             item,
-            format!("node {} is a point (no rotation): it takes no moment", l.node),
+            format!(
+                "node {} is a point (no rotation): it takes no moment",
+                l.node
+            ),
         ));
     }
     Ok(())
@@ -175,7 +186,13 @@ impl ModelBuilder {
     /// A 6-DOF node (a rigid body, or a rod's node) at `position_m` with
     /// orientation `rotation`. Returns its id.
     pub fn add_frame(&mut self, position_m: Vector3<f64>, rotation: UnitQuaternion<f64>) -> NodeId {
-        self.push_node(Frame { position_m, rotation }, 6)
+        self.push_node(
+            Frame {
+                position_m,
+                rotation,
+            },
+            6,
+        )
     }
 
     /// A rigid body (paper §3.3) at `position_m`, axes along the global axes.
@@ -185,7 +202,13 @@ impl ModelBuilder {
 
     /// A 3-DOF point (a cable node): position only.
     pub fn add_point(&mut self, position_m: Vector3<f64>) -> NodeId {
-        self.push_node(Frame { position_m, rotation: UnitQuaternion::identity() }, 3)
+        self.push_node(
+            Frame {
+                position_m,
+                rotation: UnitQuaternion::identity(),
+            },
+            3,
+        )
     }
 
     fn push_node(&mut self, frame: Frame, dofs: usize) -> NodeId {
@@ -216,7 +239,8 @@ impl ModelBuilder {
         let axis = end_m - start_m;
         let length = axis.norm();
         if spec.elements == 0 {
-            self.errors.push(MechanicsError::invalid(&item, "needs at least one element"));
+            self.errors
+                .push(MechanicsError::invalid(&item, "needs at least one element"));
         }
         if let Some(field) = spec.section.invalid_field() {
             self.errors.push(MechanicsError::invalid(
@@ -225,8 +249,10 @@ impl ModelBuilder {
             ));
         }
         if !(length.is_finite() && length > 0.0) {
-            self.errors
-                .push(MechanicsError::invalid(&item, "start and end coincide (zero length)"));
+            self.errors.push(MechanicsError::invalid(
+                &item,
+                "start and end coincide (zero length)",
+            ));
             self.rods.push(Rod { nodes: vec![] });
             return self.rods.last().cloned().expect("just pushed");
         }
@@ -278,7 +304,11 @@ impl ModelBuilder {
 
     /// A dead load at node `node` (scaled by the load factor).
     pub fn add_load(&mut self, node: NodeId, force_n: Vector3<f64>, moment_nm: Vector3<f64>) {
-        self.loads.push(NodalLoad { node, force_n, moment_nm });
+        self.loads.push(NodalLoad {
+            node,
+            force_n,
+            moment_nm,
+        });
     }
 
     /// The reference configuration of a node added so far.
@@ -301,11 +331,17 @@ impl ModelBuilder {
             let item = format!("joint {j}");
             for n in [a, b] {
                 if n >= self.reference.len() {
-                    return Err(MechanicsError::invalid(item, format!("node {n} does not exist")));
+                    return Err(MechanicsError::invalid(
+                        item,
+                        format!("node {n} does not exist"),
+                    ));
                 }
             }
             if a == b {
-                return Err(MechanicsError::invalid(item, format!("joins node {a} to itself")));
+                return Err(MechanicsError::invalid(
+                    item,
+                    format!("joins node {a} to itself"),
+                ));
             }
             if !at.iter().all(|v| v.is_finite()) {
                 return Err(MechanicsError::invalid(item, "its point is not finite"));
@@ -327,10 +363,18 @@ impl ModelBuilder {
             }
             if let JointKind::Revolute { axis } = kind {
                 if !(axis.norm().is_finite() && axis.norm() > 0.0) {
-                    return Err(MechanicsError::invalid(item, "revolute axis must be a non-zero vector"));
+                    return Err(MechanicsError::invalid(
+                        item,
+                        "revolute axis must be a non-zero vector",
+                    ));
                 }
             }
-            joints.push(Joint::new(kind, [a, b], [&self.reference[a], &self.reference[b]], at));
+            joints.push(Joint::new(
+                kind,
+                [a, b],
+                [&self.reference[a], &self.reference[b]],
+                at,
+            ));
         }
         for (n, f) in self.fixed.iter_mut().enumerate() {
             if self.node_dofs[n] == 3 {

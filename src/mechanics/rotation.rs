@@ -194,7 +194,10 @@ pub(crate) fn log_generic<S: DualNum<f64> + Copy>(r: &M3<S>) -> V3<S> {
     let s2 = dot(&s, &s);
     let factor = if s2.re() < 1e-4 && c.re() > 0.0 {
         // θ/sin θ = arcsin(x)/x with x = sin θ: 1 + x²/6 + 3x⁴/40 + 5x⁶/112 + 35x⁸/1152.
-        S::one() + s2 / 6.0 + s2 * s2 * 0.075 + s2 * s2 * s2 * (5.0 / 112.0)
+        S::one()
+            + s2 / 6.0
+            + s2 * s2 * 0.075
+            + s2 * s2 * s2 * (5.0 / 112.0)
             + s2 * s2 * s2 * s2 * (35.0 / 1152.0)
     } else {
         let sn = s2.sqrt();
@@ -236,7 +239,10 @@ mod tests {
             assert!((r - rg).norm() < 1e-15, "exp at {angle}");
             let back = log_generic(&lift_m(&r));
             let back = Vector3::new(back[0], back[1], back[2]);
-            assert!((back - theta).norm() < 1e-13 * angle.max(1e-3), "log at {angle}");
+            assert!(
+                (back - theta).norm() < 1e-13 * angle.max(1e-3),
+                "log at {angle}"
+            );
         }
     }
 

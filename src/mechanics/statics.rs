@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::assembly::{State, System};
+use super::assembly::{Evaluation, State, System};
 use super::model::{MechanicsError, Model};
 
 /// How a static solve ended.
@@ -88,7 +88,8 @@ impl StaticSettings {
     /// # Errors
     /// A value out of range, named.
     pub fn validate(&self) -> Result<(), MechanicsError> {
-        let bad = |field: &str, why: &str| Err(MechanicsError::invalid(format!("solver.{field}"), why));
+        let bad =
+            |field: &str, why: &str| Err(MechanicsError::invalid(format!("solver.{field}"), why));
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
             return bad("tolerance", "must be in (0, 1)");
         }
@@ -152,7 +153,10 @@ impl StaticSolution {
 pub struct StaticSolver {
     model: Model,
     system: System,
+    /// Size of the frame, m.
     length_scale: f64,
+    /// Largest coordinate magnitude, m (sets the roundoff of positions).
+    coordinate_scale: f64,
 }
 
 /// The outcome of Newton iterations at fixed λ.
@@ -170,13 +174,22 @@ impl StaticSolver {
     /// A pattern faer cannot analyse.
     pub fn new(model: Model) -> Result<Self, MechanicsError> {
         let system = System::new(&model)?;
-        let (mut lo, mut hi) = (nalgebra::Vector3::repeat(f64::MAX), nalgebra::Vector3::repeat(f64::MIN));
+        let (mut lo, mut hi) = (
+            nalgebra::Vector3::repeat(f64::MAX),
+            nalgebra::Vector3::repeat(f64::MIN),
+        );
         for f in &model.reference {
             lo = lo.inf(&f.position_m);
             hi = hi.sup(&f.position_m);
         }
         let length_scale = (hi - lo).norm().max(1e-9);
-        Ok(StaticSolver { model, system, length_scale })
+        let coordinate_scale = lo.amax().max(hi.amax());
+        Ok(StaticSolver {
+            model,
+            system,
+            length_scale,
+            coordinate_scale,
+        })
     }
 
     /// The model.
@@ -189,6 +202,15 @@ impl StaticSolver {
         &mut self.model
     }
 
+    /// Largest component of the reference loads.
+    fn load_scale(&self) -> f64 {
+        self.model
+            .loads
+            .iter()
+            .map(|l| l.force_n.amax().max(l.moment_nm.amax()))
+            .fold(0.0, f64::max)
+    }
+
     /// The unstressed reference state.
     pub fn reference_state(&self) -> State {
         self.system.reference_state(&self.model)
@@ -196,39 +218,34 @@ impl StaticSolver {
 
     /// Newton iterations at fixed load factor `lambda`, updating `state`.
     fn newton(&self, state: &mut State, lambda: f64, settings: &StaticSettings) -> NewtonRun {
-        let load_scale = self
-            .model
-            .loads
-            .iter()
-            .map(|l| l.force_n.amax().max(l.moment_nm.amax()))
-            .fold(0.0, f64::max)
-            * lambda.abs();
         let mut residuals = Vec::new();
         let mut first = f64::NAN;
         for it in 0..=settings.max_iterations {
             let ev = self.system.evaluate(&self.model, state, lambda);
-            let n = self.system.n_free;
-            let force = ev.residual[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let gap = ev.residual[n..].iter().fold(0.0f64, |m, v| m.max(v.abs())) / self.system.scale;
+            let (force, converged) = self.converged(&ev, lambda, settings);
             residuals.push(force);
-            if !(force.is_finite() && gap.is_finite()) {
+            if !force.is_finite() {
                 break;
             }
-            let reaction_scale = ev.reactions.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-            let tol = (settings.tolerance * load_scale.max(reaction_scale))
-                .max(64.0 * f64::EPSILON * ev.internal_scale);
-            if force <= tol && gap <= settings.tolerance * self.length_scale {
-                return NewtonRun { converged: true, iterations: it, residuals, reactions: ev.reactions };
+            if converged {
+                return NewtonRun {
+                    converged: true,
+                    iterations: it,
+                    residuals,
+                    reactions: ev.reactions,
+                };
             }
             if it == 0 {
-                first = force.max(gap * self.system.scale);
-            } else if force > 1e8 * first.max(tol) {
-                break;
+                first = force;
+            } else if force > 1e8 * first {
+                break; // diverging
             }
             if it == settings.max_iterations {
                 break;
             }
-            let Ok(lu) = self.system.factor(&ev.values) else { break };
+            let Ok(lu) = self.system.factor(&ev.values) else {
+                break;
+            };
             let mut rhs = self.system.column(&ev.residual);
             System::solve_in_place(&lu, rhs.as_mut());
             let delta: Vec<f64> = (0..self.system.n_rows).map(|i| -rhs[(i, 0)]).collect();
@@ -243,6 +260,38 @@ impl StaticSolver {
             residuals,
             reactions: vec![],
         }
+    }
+
+    /// The force residual `‖F‖∞` at an evaluation and whether it is converged:
+    /// `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞)` and joint gaps `≤ tol · L`,
+    /// where the force test never asks for less than the roundoff of the
+    /// assembled forces, `ε · (EA/L)_max · |x|_max` (coordinates of tens of
+    /// metres and stiff tubes put it near 1e-7 N).
+    pub(crate) fn converged(
+        &self,
+        ev: &Evaluation,
+        lambda: f64,
+        settings: &StaticSettings,
+    ) -> (f64, bool) {
+        let n = self.system.n_free;
+        let force = ev.residual[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let gap = ev.residual[n..].iter().fold(0.0f64, |m, v| m.max(v.abs())) / self.system.scale;
+        if !(force.is_finite() && gap.is_finite()) {
+            return (f64::NAN, false);
+        }
+        let reaction_scale = ev
+            .reactions
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let roundoff =
+            64.0 * f64::EPSILON * (ev.internal_scale + self.system.scale * self.coordinate_scale);
+        let tol = (settings.tolerance * (self.load_scale() * lambda.abs()).max(reaction_scale))
+            .max(roundoff);
+        (
+            force,
+            force <= tol && gap <= settings.tolerance * self.length_scale,
+        )
     }
 
     /// Solve from the reference configuration under the model's loads.
@@ -272,7 +321,12 @@ impl StaticSolver {
         }
     }
 
-    fn load_control(&self, start: State, lambda0: f64, settings: &StaticSettings) -> StaticSolution {
+    fn load_control(
+        &self,
+        start: State,
+        lambda0: f64,
+        settings: &StaticSettings,
+    ) -> StaticSolution {
         let clock = Instant::now();
         let mut state = start;
         let mut lambda = lambda0;
@@ -286,7 +340,9 @@ impl StaticSolver {
                 break StaticTermination::Converged;
             }
             if steps.len() >= settings.max_steps {
-                break StaticTermination::MaxSteps { load_factor: lambda };
+                break StaticTermination::MaxSteps {
+                    load_factor: lambda,
+                };
             }
             let target = (lambda + step).min(1.0);
             let mut trial = state.clone();
@@ -310,7 +366,9 @@ impl StaticSolver {
                 rejected_steps += 1;
                 step *= 0.25;
                 if step < settings.min_step {
-                    break StaticTermination::Stalled { load_factor: lambda };
+                    break StaticTermination::Stalled {
+                        load_factor: lambda,
+                    };
                 }
             }
         };
@@ -324,6 +382,30 @@ impl StaticSolver {
             reactions,
             time_s: clock.elapsed().as_secs_f64(),
         }
+    }
+
+    /// The small-displacement response: one linear solve with the tangent of
+    /// the unstressed reference configuration, `K₀ u = f` (joints linearised).
+    ///
+    /// # Errors
+    /// [`MechanicsError::Mechanism`] when `K₀` is singular.
+    pub fn linear_response(&self) -> Result<State, MechanicsError> {
+        let mut state = self.reference_state();
+        let ev = self.system.evaluate(&self.model, &state, 1.0);
+        let lu = self
+            .system
+            .factor(&ev.values)
+            .map_err(|detail| MechanicsError::Mechanism { detail })?;
+        let mut rhs = self.system.column(&ev.residual);
+        System::solve_in_place(&lu, rhs.as_mut());
+        let delta: Vec<f64> = (0..self.system.n_rows).map(|i| -rhs[(i, 0)]).collect();
+        if !delta.iter().all(|d| d.is_finite()) {
+            return Err(MechanicsError::Mechanism {
+                detail: "the linear solve gave non-finite displacements".into(),
+            });
+        }
+        self.system.apply(&mut state, &delta, 1.0);
+        Ok(state)
     }
 
     fn arc_length(&self, start: State, lambda0: f64, settings: &StaticSettings) -> StaticSolution {

@@ -1,0 +1,122 @@
+//! The ring-truss frame of a scene (paper §3.1, DESIGN §5): N vertical
+//! battens, upper and lower longerons, one diagonal per bay made of a thick
+//! and a thin tube, and 2N hinge bodies.
+//!
+//! Joints as the paper: batten–hinge fixed; longeron–hinge and diagonal–hinge
+//! revolute about the bay's normal (the locked deployed state is held by the
+//! triangulating diagonal); thick–thin diagonal fixed at mid-length. Supports:
+//! an isostatic 3-2-1 set on three bottom hinges, so the self-equilibrated pull
+//! of the net deforms the truss without reactions.
+//!
+//! The scene gives one tube: the thick and thin diagonal tubes use its section
+//! (the paper gives no separate dimensions).
+
+use nalgebra::Vector3;
+
+use crate::geometry::RingTrussLayout;
+use crate::mechanics::{JointKind, MechanicsError, Model, ModelBuilder, NodeId, RodSpec, Section};
+use crate::scene::{Scene, Supports};
+
+/// A ring-truss frame and where the net attaches to it.
+#[derive(Debug, Clone)]
+pub struct RingTruss {
+    /// The frame.
+    pub model: Model,
+    /// Hinge bodies: top hinges `0..N` (front net), then bottom hinges (rear net).
+    pub attachments: Vec<NodeId>,
+    /// The supported bottom hinges and their fixed components `[x, y, z]`.
+    pub supports: Vec<(usize, [bool; 3])>,
+}
+
+fn v(p: &[f64; 3]) -> Vector3<f64> {
+    Vector3::new(p[0], p[1], p[2])
+}
+
+impl RingTruss {
+    /// The frame of `scene`'s truss on the hinge layout `layout`.
+    ///
+    /// # Errors
+    /// A degenerate layout (coincident hinges), named.
+    pub fn new(scene: &Scene, layout: &RingTrussLayout) -> Result<Self, MechanicsError> {
+        let t = &scene.truss;
+        let spec = RodSpec {
+            section: Section::tube(
+                t.tube_outer_diameter_m,
+                t.tube_inner_diameter_m,
+                t.youngs_modulus_pa,
+                t.shear_modulus_pa,
+            ),
+            elements: t.elements_per_rod,
+            kind: t.element,
+        };
+        let n = layout.bays();
+        let top: Vec<Vector3<f64>> = layout.top_m.iter().map(v).collect();
+        let bottom: Vec<Vector3<f64>> = layout.bottom_m.iter().map(v).collect();
+        let mut b = ModelBuilder::new();
+        let top_hinges: Vec<NodeId> = top.iter().map(|p| b.add_body(*p)).collect();
+        let bottom_hinges: Vec<NodeId> = bottom.iter().map(|p| b.add_body(*p)).collect();
+
+        for k in 0..n {
+            let next = (k + 1) % n;
+            // The bay's normal: across the plane of its longeron and batten.
+            let normal = (top[next] - top[k]).cross(&(top[k] - bottom[k]));
+            let radial_up = top[k] - bottom[k];
+
+            let batten = b.add_rod(bottom[k], top[k], normal, &spec);
+            b.add_joint(
+                JointKind::Fixed,
+                batten.start(),
+                bottom_hinges[k],
+                bottom[k],
+            );
+            b.add_joint(JointKind::Fixed, batten.end(), top_hinges[k], top[k]);
+
+            let hinge = JointKind::Revolute { axis: normal };
+            for (hinges, points) in [(&top_hinges, &top), (&bottom_hinges, &bottom)] {
+                let longeron = b.add_rod(points[k], points[next], radial_up, &spec);
+                b.add_joint(hinge, longeron.start(), hinges[k], points[k]);
+                b.add_joint(hinge, longeron.end(), hinges[next], points[next]);
+            }
+
+            let middle = (bottom[k] + top[next]) * 0.5;
+            let thick = b.add_rod(bottom[k], middle, normal, &spec);
+            let thin = b.add_rod(middle, top[next], normal, &spec);
+            b.add_joint(hinge, thick.start(), bottom_hinges[k], bottom[k]);
+            b.add_joint(JointKind::Fixed, thick.end(), thin.start(), middle);
+            b.add_joint(hinge, thin.end(), top_hinges[next], top[next]);
+        }
+
+        let supports = match t.supports {
+            Supports::Isostatic => isostatic(&bottom),
+        };
+        for &(k, fixed) in &supports {
+            b.fix(
+                bottom_hinges[k],
+                [fixed[0], fixed[1], fixed[2], false, false, false],
+            );
+        }
+        let attachments = top_hinges.into_iter().chain(bottom_hinges).collect();
+        Ok(RingTruss {
+            model: b.build()?,
+            attachments,
+            supports,
+        })
+    }
+}
+
+/// A 3-2-1 support on bottom hinges `0`, `N/3`, `2N/3`: all translations of the
+/// first; at the second, the vertical and the horizontal component that a
+/// rotation about the vertical through the first would move most; the vertical
+/// of the third. Rigid motions are removed and nothing more.
+fn isostatic(bottom: &[Vector3<f64>]) -> Vec<(usize, [bool; 3])> {
+    let n = bottom.len();
+    let (a, b, c) = (0, n / 3, (2 * n) / 3);
+    let ab = bottom[b] - bottom[a];
+    // ẑ × (B − A) = (−Δy, Δx): fix y when |Δx| dominates.
+    let fix_y = ab.x.abs() >= ab.y.abs();
+    vec![
+        (a, [true, true, true]),
+        (b, [!fix_y, fix_y, true]),
+        (c, [false, false, true]),
+    ]
+}

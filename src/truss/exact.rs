@@ -1,0 +1,125 @@
+//! The geometrically exact truss (paper §3): beams, hinge bodies and joints
+//! in large displacement, solved to equilibrium under the net's pull.
+//!
+//! Warm start: each response starts from the previous equilibrium (the outer
+//! design loop changes the loads little between iterations) and falls back to
+//! a load ramp from the unstressed truss when that does not converge.
+
+use std::time::Instant;
+
+use nalgebra::Vector3;
+
+use super::{check_loads, layout_points, RingTruss, TrussError, TrussOracle, TrussResponse};
+use crate::geometry::RingTrussLayout;
+use crate::mechanics::{NodalLoad, NodeId, State, StaticSettings, StaticSolver};
+
+/// The ring truss in large displacement.
+pub struct ExactTruss {
+    solver: StaticSolver,
+    attachments: Vec<NodeId>,
+    points: Vec<[f64; 3]>,
+    settings: StaticSettings,
+    previous: Option<State>,
+}
+
+pub(crate) fn nodal_loads(attachments: &[NodeId], loads_n: &[[f64; 3]]) -> Vec<NodalLoad> {
+    attachments
+        .iter()
+        .zip(loads_n)
+        .map(|(&node, f)| NodalLoad {
+            node,
+            force_n: Vector3::new(f[0], f[1], f[2]),
+            moment_nm: Vector3::zeros(),
+        })
+        .collect()
+}
+
+pub(crate) fn positions(state: &State, attachments: &[NodeId]) -> Vec<[f64; 3]> {
+    attachments
+        .iter()
+        .map(|&n| {
+            let p = state.frames[n].position_m;
+            [p.x, p.y, p.z]
+        })
+        .collect()
+}
+
+impl ExactTruss {
+    /// The exact model of a ring-truss frame.
+    ///
+    /// # Errors
+    /// A frame faer cannot analyse.
+    pub fn new(truss: RingTruss, layout: &RingTrussLayout) -> Result<Self, TrussError> {
+        Ok(ExactTruss {
+            solver: StaticSolver::new(truss.model)?,
+            attachments: truss.attachments,
+            points: layout_points(layout),
+            settings: StaticSettings::default(),
+            previous: None,
+        })
+    }
+
+    /// The static solver settings (tolerance, steps).
+    pub fn settings_mut(&mut self) -> &mut StaticSettings {
+        &mut self.settings
+    }
+
+    /// The last equilibrium state, if any.
+    pub fn state(&self) -> Option<&State> {
+        self.previous.as_ref()
+    }
+}
+
+impl TrussOracle for ExactTruss {
+    fn name(&self) -> &'static str {
+        "exact"
+    }
+
+    fn attachments(&self) -> &[[f64; 3]] {
+        &self.points
+    }
+
+    fn respond(&mut self, loads_n: &[[f64; 3]]) -> Result<TrussResponse, TrussError> {
+        check_loads(loads_n, self.points.len())?;
+        let clock = Instant::now();
+        self.solver
+            .model_mut()
+            .set_loads(nodal_loads(&self.attachments, loads_n))?;
+        let mut iterations = 0;
+        let mut solution = None;
+        if let Some(previous) = self.previous.take() {
+            // One full step from the previous equilibrium; no cuts.
+            let warm = StaticSettings {
+                min_step: 0.5,
+                ..self.settings.clone()
+            };
+            let s = self.solver.solve_from(previous, 0.0, &warm)?;
+            iterations += s.newton_iterations;
+            if s.converged() {
+                solution = Some(s);
+            }
+        }
+        let solution = match solution {
+            Some(s) => s,
+            None => {
+                let s = self.solver.solve(&self.settings)?;
+                iterations += s.newton_iterations;
+                if !s.converged() {
+                    return Err(TrussError::NoEquilibrium {
+                        termination: s.termination,
+                        load_factor: s.load_factor,
+                    });
+                }
+                s
+            }
+        };
+        let response = TrussResponse {
+            positions_m: positions(&solution.state, &self.attachments),
+            newton_iterations: iterations,
+            load_steps: solution.steps.len(),
+            time_s: clock.elapsed().as_secs_f64(),
+        };
+        self.previous = Some(solution.state);
+        Ok(response)
+    }
+}

@@ -1,0 +1,142 @@
+//! The ring truss and its response to the net's pull (paper §3, DESIGN §5):
+//! one trait, [`TrussOracle`], with three models of increasing fidelity.
+//!
+//! * [`RigidTruss`] — no deformation: the conventional method;
+//! * [`LinearTruss`] — a small-displacement frame: one sparse solve;
+//! * [`ExactTruss`] — geometrically exact beams, rigid hinges and joints,
+//!   solved by Newton with adaptive load steps (warm-started across calls).
+//!
+//! Attachment points are the hinge bodies: top hinges `0..N` (front net), then
+//! bottom hinges `N..2N` (rear net), the order of the net's fixed nodes.
+
+mod builder;
+mod exact;
+mod linear;
+mod rigid;
+
+pub use builder::RingTruss;
+pub use exact::ExactTruss;
+pub use linear::LinearTruss;
+pub use rigid::RigidTruss;
+
+use serde::Serialize;
+
+use crate::geometry::RingTrussLayout;
+use crate::mechanics::{MechanicsError, StaticTermination};
+use crate::scene::{Scene, TrussModel};
+
+/// A truss model that cannot respond.
+#[derive(Debug, thiserror::Error)]
+pub enum TrussError {
+    /// The frame could not be built or analysed.
+    #[error("ring truss: {0}")]
+    Mechanics(#[from] MechanicsError),
+    /// The loads do not match the attachment points.
+    #[error(
+        "truss loads: {given} given, {expected} attachment points (top hinges, then bottom hinges)"
+    )]
+    LoadCount {
+        /// Loads given.
+        given: usize,
+        /// Attachment points.
+        expected: usize,
+    },
+    /// A load is not finite.
+    #[error("truss loads: the load on attachment point {point} is not finite")]
+    NonFiniteLoad {
+        /// The attachment point.
+        point: usize,
+    },
+    /// No equilibrium under the full load: the truss buckles or collapses.
+    #[error(
+        "the ring truss found no equilibrium under the net's pull ({termination:?}, last converged \
+         load factor {load_factor:.4}): the loads exceed what the truss can carry"
+    )]
+    NoEquilibrium {
+        /// How the static solve ended.
+        termination: StaticTermination,
+        /// The largest load factor reached.
+        load_factor: f64,
+    },
+}
+
+impl TrussError {
+    /// True when the input (the loads or the scene) is at fault.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            TrussError::Mechanics(MechanicsError::Invalid { .. })
+                | TrussError::LoadCount { .. }
+                | TrussError::NonFiniteLoad { .. }
+        )
+    }
+}
+
+/// The truss's answer to one set of attachment loads.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TrussResponse {
+    /// Deformed attachment points, m: 2N × 3.
+    pub positions_m: Vec<[f64; 3]>,
+    /// Newton iterations spent (0 for the rigid and linear models).
+    pub newton_iterations: usize,
+    /// Converged load steps (0 for the rigid and linear models).
+    pub load_steps: usize,
+    /// Wall time, s.
+    pub time_s: f64,
+}
+
+/// The response of a ring truss to forces at its attachment points: the
+/// oracle every outer design iteration queries (DESIGN §5–6).
+pub trait TrussOracle: Send {
+    /// The model's name: `rigid`, `linear` or `exact`.
+    fn name(&self) -> &'static str;
+    /// Undeformed attachment points, m: 2N × 3.
+    fn attachments(&self) -> &[[f64; 3]];
+    /// Deformed attachment points under `loads_n` (N, one per attachment point,
+    /// the pull of the net on the hinge).
+    fn respond(&mut self, loads_n: &[[f64; 3]]) -> Result<TrussResponse, TrussError>;
+}
+
+/// The reference attachment points of a layout: top hinges, then bottom hinges.
+pub(crate) fn layout_points(layout: &RingTrussLayout) -> Vec<[f64; 3]> {
+    layout
+        .top_m
+        .iter()
+        .chain(&layout.bottom_m)
+        .copied()
+        .collect()
+}
+
+/// Check the count and values of attachment loads.
+pub(crate) fn check_loads(loads_n: &[[f64; 3]], expected: usize) -> Result<(), TrussError> {
+    if loads_n.len() != expected {
+        return Err(TrussError::LoadCount {
+            given: loads_n.len(),
+            expected,
+        });
+    }
+    match loads_n
+        .iter()
+        .position(|l| !l.iter().all(|v| v.is_finite()))
+    {
+        Some(point) => Err(TrussError::NonFiniteLoad { point }),
+        None => Ok(()),
+    }
+}
+
+/// The oracle a scene asks for (`[effects] truss`): only that model is built —
+/// a rigid scene never constructs a beam model.
+///
+/// # Errors
+/// A frame that cannot be built.
+pub fn oracle(
+    model: TrussModel,
+    scene: &Scene,
+    layout: &RingTrussLayout,
+) -> Result<Box<dyn TrussOracle>, TrussError> {
+    Ok(match model {
+        TrussModel::Rigid => Box::new(RigidTruss::new(layout)),
+        TrussModel::Linear => Box::new(LinearTruss::new(RingTruss::new(scene, layout)?, layout)?),
+        TrussModel::Exact => Box::new(ExactTruss::new(RingTruss::new(scene, layout)?, layout)?),
+    })
+}
