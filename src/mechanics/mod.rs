@@ -10,8 +10,9 @@
 
 mod arc_length;
 mod assembly;
-pub mod cantilever;
 pub mod beam;
+pub mod cantilever;
+pub mod frame_file;
 pub mod joint;
 pub mod model;
 pub mod rotation;
@@ -19,6 +20,7 @@ pub mod statics;
 
 pub use assembly::State;
 pub use beam::{ElementKind, Frame, Section};
+pub use frame_file::{FrameFile, FrameFileError, NodeOrigin};
 pub use joint::JointKind;
 pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, Rod, RodSpec};
 pub use statics::{
