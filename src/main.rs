@@ -6,7 +6,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use ringmesh::run::Progress;
+use ringmesh::mechanics::{ElementKind, StaticTermination};
+use ringmesh::run::{CantileverTable, FrameOutput, Progress};
 use ringmesh::uniformity::SolverKind;
 
 /// Prints a line to stdout; a closed pipe (`ringmesh … | head`) is not an error.
@@ -121,6 +122,36 @@ enum Command {
         /// Output folder [default: results/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
+    },
+    /// Large-deformation statics of any frame of rods, rigid bodies and joints.
+    ///
+    /// Writes every node's position, displacement and rotation vector, the
+    /// support reactions and the solver's statistics (termination, load steps,
+    /// Newton iterations, residual history, time) as JSON; prints a summary.
+    /// The file format is documented in src/mechanics/frame_file.rs.
+    ///
+    /// Example: ringmesh frame problems/cantilever-moment.toml
+    Frame {
+        /// The frame file (TOML).
+        file: PathBuf,
+        /// Output JSON file [default: results/<file stem>/frame.json].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// The paper's cantilever rolled up by a tip moment (Tables 1–2): analytic,
+    /// paper and ours side by side, ML/(πEI) = 0.2 … 2.0 (the full circle).
+    ///
+    /// Example: ringmesh cantilever --elements 10 --element crisfield-jelenic
+    Cantilever {
+        /// Elements along the cantilever.
+        #[arg(long, default_value_t = 10, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
+        elements: usize,
+        /// The beam element.
+        #[arg(long, value_enum, default_value = "se3")]
+        element: ElementKind,
+        /// Print the table as JSON instead.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -242,6 +273,26 @@ fn main() -> ExitCode {
                 }
             })
         }
+        Command::Frame { file, output } => {
+            ringmesh::run::frame(file, output.as_deref()).map(|(o, path)| {
+                say!("{}", frame_summary(&o));
+                say!("wrote {}", path.display());
+            })
+        }
+        Command::Cantilever {
+            elements,
+            element,
+            json,
+        } => ringmesh::run::cantilever(*elements, *element).map(|table| {
+            if *json {
+                say!(
+                    "{}",
+                    serde_json::to_string_pretty(&table).expect("a table serialises")
+                );
+            } else {
+                print_cantilever(&table);
+            }
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -249,5 +300,117 @@ fn main() -> ExitCode {
             eprintln!("error: {error}");
             ExitCode::from(if error.is_bad_input() { 2 } else { 1 })
         }
+    }
+}
+
+/// One paragraph: size, how the solve ended, and its largest results.
+fn frame_summary(o: &FrameOutput) -> String {
+    let c = &o.counts;
+    let ending = match o.termination {
+        StaticTermination::Converged => "converged at the full load".to_string(),
+        StaticTermination::Stalled { load_factor } => {
+            format!("STALLED: the load step fell below the minimum at load factor {load_factor:.6}")
+        }
+        StaticTermination::LimitPoint { limit_load_factor } => {
+            format!("passed a LIMIT POINT at load factor {limit_load_factor:.6}")
+        }
+        StaticTermination::MaxSteps { load_factor } => {
+            format!("ran out of steps (MAX STEPS) at load factor {load_factor:.6}")
+        }
+    };
+    let reaction = o
+        .reactions
+        .iter()
+        .map(|r| norm(r.force_n))
+        .fold(0.0, f64::max);
+    let moment = o
+        .reactions
+        .iter()
+        .map(|r| norm(r.moment_nm))
+        .fold(0.0, f64::max);
+    let largest = &o.nodes[o.max_displacement_node.min(o.nodes.len().saturating_sub(1))];
+    let at = match (&largest.rod, largest.rod_node, &largest.body) {
+        (Some(rod), Some(i), _) => format!("rod {rod} node {i}"),
+        (_, _, Some(body)) => format!("body {body}"),
+        _ => format!("node {}", largest.id),
+    };
+    format!(
+        "{}: {} nodes ({} rods, {} elements, {} bodies, {} joints); {} in {} load steps, \
+         {} Newton iterations, {} rejected steps, {:.3} ms; largest displacement {:.6e} m \
+         at {at}; largest reaction {:.6e} N, {:.6e} N·m.",
+        o.file,
+        c.nodes,
+        c.rods,
+        c.elements,
+        c.bodies,
+        c.joints,
+        ending,
+        o.load_steps,
+        o.newton_iterations,
+        o.rejected_steps,
+        1e3 * o.time_s,
+        o.max_displacement_m,
+        reaction,
+        moment
+    )
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    v.iter().map(|c| c * c).sum::<f64>().sqrt()
+}
+
+/// The cantilever table, one load per line.
+fn print_cantilever(t: &CantileverTable) {
+    say!(
+        "cantilever L = 10, EI = 100 under a tip moment: {} {} elements (paper §3.4, Tables 1-2)",
+        t.elements,
+        t.element
+    );
+    say!(
+        "{:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} | {:>6} {:>5} {:>9}",
+        "ML/(πEI)",
+        "analytic",
+        "",
+        "paper",
+        "",
+        "ours",
+        "",
+        "rel. err",
+        "Newton",
+        "steps",
+        "time ms"
+    );
+    say!(
+        "{:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} | {:>6} {:>5} {:>9}",
+        "",
+        "axial",
+        "vertical",
+        "axial",
+        "vertical",
+        "axial",
+        "vertical",
+        "",
+        "",
+        "",
+        ""
+    );
+    for r in &t.rows {
+        let paper = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.5}"));
+        let row = &r.row;
+        say!(
+            "{:>9.1} | {:>9.5} {:>9.5} | {:>9} {:>9} | {:>9.5} {:>9.5} | {:>9.2e} | {:>6} {:>5} {:>9.3}{}",
+            row.m_ratio,
+            row.analytic_axial_m,
+            row.analytic_vertical_m,
+            paper(r.paper_axial_m),
+            paper(r.paper_vertical_m),
+            row.axial_m,
+            row.vertical_m,
+            row.relative_error,
+            row.newton_iterations,
+            row.load_steps,
+            1e3 * row.time_s,
+            if row.converged { "" } else { "  NOT CONVERGED" }
+        );
     }
 }
