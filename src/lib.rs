@@ -54,6 +54,9 @@ pub enum Error {
     /// Reading or writing a file.
     #[error(transparent)]
     Report(#[from] report::ReportError),
+    /// The ring truss cannot respond to its loads.
+    #[error(transparent)]
+    Truss(#[from] truss::TrussError),
     /// An invalid frame file, or a frame that cannot be built.
     #[error(transparent)]
     Frame(#[from] mechanics::FrameFileError),
@@ -68,6 +71,7 @@ impl Error {
             Error::Fdm(e) => e.is_bad_input(),
             Error::Uniformity(e) => e.is_bad_input(),
             Error::Report(e) => e.is_bad_input(),
+            Error::Truss(e) => e.is_bad_input(),
             Error::Frame(e) => e.is_bad_input(),
         }
     }

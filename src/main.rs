@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use ringmesh::mechanics::{ElementKind, StaticTermination};
 use ringmesh::run::{CantileverTable, FrameOutput, Progress};
+use ringmesh::scene::TrussModel;
 use ringmesh::uniformity::SolverKind;
 
 /// Prints a line to stdout; a closed pipe (`ringmesh … | head`) is not an error.
@@ -135,6 +136,26 @@ enum Command {
         /// The frame file (TOML).
         file: PathBuf,
         /// Output JSON file [default: results/<file stem>/frame.json].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// The ring truss's response to the pull of the scene's net (forward FDM
+    /// with its initial q) or to loads from a file: attachment displacements.
+    ///
+    /// Loads file: {"loads_n": [[fx, fy, fz], ...]}, top hinges then bottom
+    /// hinges, N. Writes truss-<model>.json to results/<scene>/.
+    ///
+    /// Example: ringmesh truss problems/paper-26m.toml --model linear
+    Truss {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// Truss model [default: the scene's effects.truss].
+        #[arg(long, value_enum)]
+        model: Option<TrussModel>,
+        /// Attachment loads (JSON) instead of the net's pull.
+        #[arg(long)]
+        loads: Option<PathBuf>,
+        /// Output JSON file [default: results/<scene name>/truss-<model>.json].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -279,6 +300,24 @@ fn main() -> ExitCode {
                 say!("wrote {}", path.display());
             })
         }
+        Command::Truss {
+            scene,
+            model,
+            loads,
+            output,
+        } => ringmesh::run::truss(scene, *model, loads.as_deref(), output.as_deref()).map(
+            |(r, path)| {
+                say!(
+                    "{} truss under loads from {}: max displacement {:.6e} m, {} Newton iterations, {} load steps, {:.3} s",
+                    r.model, r.loads_from, r.max_displacement_m, r.newton_iterations, r.load_steps, r.time_s
+                );
+                for a in &r.attachments {
+                    let d = a.displacement_m;
+                    say!("  {:<10} u = [{:+.4e}, {:+.4e}, {:+.4e}] m", a.hinge, d[0], d[1], d[2]);
+                }
+                say!("wrote {}", path.display());
+            },
+        ),
         Command::Cantilever {
             elements,
             element,

@@ -15,7 +15,8 @@ use crate::mechanics::{
 };
 use crate::network::{norm3, Network, NetworkSummary};
 use crate::report::{cables_csv, front_csv, front_plot, network_vtu, write_atomic, write_json};
-use crate::scene::Scene;
+use crate::scene::{Scene, TrussModel};
+use crate::truss::SceneTrussResponse;
 use crate::uniformity::{
     design_front, Design, FrontPoint, SolverKind, SurfaceTarget, Termination, UniformityError,
     UniformityProblem, UniformitySet,
@@ -500,4 +501,29 @@ pub fn cantilever(elements: usize, kind: ElementKind) -> Result<CantileverTable,
         element: kind.name().to_string(),
         rows,
     })
+}
+
+/// `ringmesh truss`: the scene's truss model (default: the scene's
+/// `[effects] truss`) under the pull of its net (forward FDM with the initial
+/// q) or under the loads of a file; writes `truss-<model>.json` beside the
+/// scene's other results.
+pub fn truss(
+    scene_path: &Path,
+    model: Option<TrussModel>,
+    loads_path: Option<&Path>,
+    output_path: Option<&Path>,
+) -> Result<(SceneTrussResponse, PathBuf), Error> {
+    let scene = Scene::read(scene_path)?;
+    let model = model.unwrap_or(scene.effects.truss);
+    let loads = match loads_path {
+        Some(p) => Some((p.display().to_string(), crate::truss::read_loads(p)?)),
+        None => None,
+    };
+    let response = crate::truss::respond(&scene, model, loads)?;
+    let path = output_path.map_or_else(
+        || default_output_dir(&scene).join(format!("truss-{}.json", response.model)),
+        Path::to_path_buf,
+    );
+    write_json(&path, &response)?;
+    Ok((response, path))
 }

@@ -179,7 +179,7 @@ impl Cables {
 }
 
 /// Which truss model the design loop uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum TrussModel {
     /// No deformation: the conventional method.

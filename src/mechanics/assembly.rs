@@ -217,7 +217,10 @@ impl System {
                 let mu = state.multipliers[first + r];
                 residual[self.joint_row[k] + r] = s * row.value;
                 for (slot, &n) in j.nodes.iter().enumerate() {
-                    for (f, g) in full[n].iter_mut().zip(&row.gradient[6 * slot..6 * slot + 6]) {
+                    for (f, g) in full[n]
+                        .iter_mut()
+                        .zip(&row.gradient[6 * slot..6 * slot + 6])
+                    {
                         *f += s * mu * g;
                     }
                     for c in (0..6).filter(|&c| self.dof[n][c] != FIXED) {

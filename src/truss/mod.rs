@@ -13,11 +13,13 @@ mod builder;
 mod exact;
 mod linear;
 mod rigid;
+mod scene_response;
 
 pub use builder::RingTruss;
 pub use exact::ExactTruss;
 pub use linear::LinearTruss;
 pub use rigid::RigidTruss;
+pub use scene_response::{read_loads, respond, AttachmentResponse, LoadsFile, SceneTrussResponse};
 
 use serde::Serialize;
 
@@ -40,6 +42,14 @@ pub enum TrussError {
         given: usize,
         /// Attachment points.
         expected: usize,
+    },
+    /// A loads file that cannot be read as `{"loads_n": [[fx, fy, fz], …]}`.
+    #[error("{path}: {reason}")]
+    LoadsFile {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
     },
     /// A load is not finite.
     #[error("truss loads: the load on attachment point {point} is not finite")]
@@ -67,6 +77,7 @@ impl TrussError {
             self,
             TrussError::Mechanics(MechanicsError::Invalid { .. })
                 | TrussError::LoadCount { .. }
+                | TrussError::LoadsFile { .. }
                 | TrussError::NonFiniteLoad { .. }
         )
     }
