@@ -854,7 +854,6 @@ fn load_control_stalls_at_the_von_mises_limit_point() {
     );
 }
 
-
 // ---------------------------------------------------------------------------
 // Bad input
 
