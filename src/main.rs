@@ -131,7 +131,7 @@ enum Command {
     /// Newton iterations, residual history, time) as JSON; prints a summary.
     /// The file format is documented in src/mechanics/frame_file.rs.
     ///
-    /// Example: ringmesh frame problems/cantilever-moment.toml
+    /// Example: ringmesh frame problems/frames/cantilever-moment.toml
     Frame {
         /// The frame file (TOML).
         file: PathBuf,

@@ -13,7 +13,7 @@ use serde_json::Value;
 
 fn problem(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("problems")
+        .join("problems/frames")
         .join(name)
 }
 
