@@ -59,8 +59,12 @@ pub(crate) struct Evaluation {
     pub values: Vec<f64>,
     /// Residual of every fixed component: the support reactions, per node.
     pub reactions: Vec<[f64; 6]>,
-    /// Largest internal nodal force component of any element (roundoff scale).
+    /// Largest internal nodal force component of any element or cable
+    /// (roundoff scale).
     pub internal_scale: f64,
+    /// Largest force component of any cable: the force scale of a prestressed
+    /// structure with no external load.
+    pub prestress_scale: f64,
 }
 
 impl System {
@@ -102,6 +106,17 @@ impl System {
             for a in e.nodes {
                 for b in e.nodes {
                     block(a, b, &mut pattern);
+                }
+            }
+        }
+        for c in &model.cables {
+            for a in c.nodes {
+                for b in c.nodes {
+                    for &i in dof[a][..3].iter().filter(|&&i| i != FIXED) {
+                        for &j in dof[b][..3].iter().filter(|&&j| j != FIXED) {
+                            pattern.push(Pair { row: i, col: j });
+                        }
+                    }
                 }
             }
         }
@@ -188,6 +203,32 @@ impl System {
             }
         }
 
+        let mut prestress_scale = 0.0f64;
+        for c in &model.cables {
+            let [a, b] = c.nodes;
+            let (f, k) = c.force_tangent(
+                &state.frames[a].position_m,
+                &state.frames[b].position_m,
+                lambda,
+            );
+            prestress_scale = prestress_scale.max(f.amax());
+            for comp in 0..3 {
+                full[a][comp] -= f[comp];
+                full[b][comp] += f[comp];
+            }
+            for (sa, na) in c.nodes.into_iter().enumerate() {
+                for (sb, nb) in c.nodes.into_iter().enumerate() {
+                    let sign = if sa == sb { 1.0 } else { -1.0 };
+                    for ca in (0..3).filter(|&c| self.dof[na][c] != FIXED) {
+                        for cb in (0..3).filter(|&c| self.dof[nb][c] != FIXED) {
+                            values.push(sign * k[(ca, cb)]);
+                        }
+                    }
+                }
+            }
+        }
+        internal_scale = internal_scale.max(prestress_scale);
+
         let mut residual = vec![0.0; self.n_rows];
         let mut rows: Vec<ConstraintRow> = Vec::new();
         let s = self.scale;
@@ -254,6 +295,7 @@ impl System {
             values,
             reactions,
             internal_scale,
+            prestress_scale,
         }
     }
 

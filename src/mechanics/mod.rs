@@ -11,6 +11,7 @@
 mod arc_length;
 mod assembly;
 pub mod beam;
+pub mod cable;
 pub mod cantilever;
 pub mod frame_file;
 pub mod joint;
@@ -20,6 +21,7 @@ pub mod statics;
 
 pub use assembly::State;
 pub use beam::{ElementKind, Frame, Section};
+pub use cable::{Cable, CableState};
 pub use frame_file::{FrameFile, FrameFileError, NodeOrigin};
 pub use joint::JointKind;
 pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, Rod, RodSpec};

@@ -8,6 +8,7 @@
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 use super::beam::{BeamElement, ElementKind, Frame, Section};
+use super::cable::Cable;
 use super::joint::{Joint, JointKind};
 
 /// Index of a node in a [`Model`].
@@ -89,6 +90,7 @@ pub struct Model {
     /// Degrees of freedom per node: 6 (frame) or 3 (point).
     pub(crate) node_dofs: Vec<usize>,
     pub(crate) elements: Vec<BeamElement>,
+    pub(crate) cables: Vec<Cable>,
     pub(crate) joints: Vec<Joint>,
     /// Fixed components per node: translations x, y, z, rotations about x, y, z.
     pub(crate) fixed: Vec<[bool; 6]>,
@@ -109,6 +111,10 @@ impl Model {
     /// Number of joints.
     pub fn joint_count(&self) -> usize {
         self.joints.len()
+    }
+    /// The cables, in the order they were added.
+    pub fn cables(&self) -> &[Cable] {
+        &self.cables
     }
     /// The rods, in the order they were added.
     pub fn rods(&self) -> &[Rod] {
@@ -164,12 +170,58 @@ fn check_load(i: usize, l: &NodalLoad, node_dofs: &[usize]) -> Result<(), Mechan
     Ok(())
 }
 
+fn check_cable(k: usize, c: &Cable, reference: &[Frame]) -> Result<(), MechanicsError> {
+    let item = format!("cable {k}");
+    let [a, b] = c.nodes;
+    for n in [a, b] {
+        if n >= reference.len() {
+            return Err(MechanicsError::invalid(
+                item,
+                format!("node {n} does not exist"),
+            ));
+        }
+    }
+    if a == b {
+        return Err(MechanicsError::invalid(
+            item,
+            format!("joins node {a} to itself"),
+        ));
+    }
+    if (reference[a].position_m - reference[b].position_m).norm() == 0.0 {
+        return Err(MechanicsError::invalid(
+            item,
+            format!("nodes {a} and {b} coincide (zero length)"),
+        ));
+    }
+    if !(c.axial_n.is_finite() && c.axial_n > 0.0) {
+        return Err(MechanicsError::invalid(
+            item,
+            format!(
+                "axial stiffness {} N must be finite and positive",
+                c.axial_n
+            ),
+        ));
+    }
+    if let Some(l) = c
+        .rest_lengths_m
+        .iter()
+        .find(|l| !(l.is_finite() && **l > 0.0))
+    {
+        return Err(MechanicsError::invalid(
+            item,
+            format!("unstressed length {l} m must be finite and positive"),
+        ));
+    }
+    Ok(())
+}
+
 /// Builds a [`Model`] item by item; [`ModelBuilder::build`] validates it.
 #[derive(Debug, Default, Clone)]
 pub struct ModelBuilder {
     reference: Vec<Frame>,
     node_dofs: Vec<usize>,
     elements: Vec<BeamElement>,
+    cables: Vec<Cable>,
     joints: Vec<(JointKind, NodeId, NodeId, Vector3<f64>)>,
     fixed: Vec<[bool; 6]>,
     loads: Vec<NodalLoad>,
@@ -287,6 +339,25 @@ impl ModelBuilder {
         self.joints.push((kind, a, b, at_m));
     }
 
+    /// A tension-only cable between the positions of nodes `a` and `b` with
+    /// axial stiffness `axial_n` (EA, N) and unstressed length ramped from
+    /// `rest_lengths_m[0]` at load factor 0 to `rest_lengths_m[1]` at 1
+    /// (see [`super::cable`]). Returns its index.
+    pub fn add_cable(
+        &mut self,
+        a: NodeId,
+        b: NodeId,
+        axial_n: f64,
+        rest_lengths_m: [f64; 2],
+    ) -> usize {
+        self.cables.push(Cable {
+            nodes: [a, b],
+            axial_n,
+            rest_lengths_m,
+        });
+        self.cables.len() - 1
+    }
+
     /// Fix components of node `node`: `[x, y, z, θx, θy, θz]` (global axes).
     pub fn fix(&mut self, node: NodeId, components: [bool; 6]) {
         match self.fixed.get_mut(node) {
@@ -376,6 +447,9 @@ impl ModelBuilder {
                 at,
             ));
         }
+        for (k, c) in self.cables.iter().enumerate() {
+            check_cable(k, c, &self.reference)?;
+        }
         for (n, f) in self.fixed.iter_mut().enumerate() {
             if self.node_dofs[n] == 3 {
                 f[3..].iter_mut().for_each(|c| *c = true);
@@ -388,6 +462,7 @@ impl ModelBuilder {
             reference: self.reference,
             node_dofs: self.node_dofs,
             elements: self.elements,
+            cables: self.cables,
             joints,
             fixed: self.fixed,
             loads: self.loads,

@@ -55,7 +55,8 @@ pub enum PathControl {
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct StaticSettings {
-    /// Relative force tolerance: `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞)`.
+    /// Relative force tolerance: `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞,
+    /// largest cable force)`.
     pub tolerance: f64,
     /// Newton iterations per step before the step is cut.
     pub max_iterations: usize,
@@ -263,7 +264,7 @@ impl StaticSolver {
     }
 
     /// The force residual `‖F‖∞` at an evaluation and whether it is converged:
-    /// `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞)` and joint gaps `≤ tol · L`,
+    /// `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞, cable forces)` and joint gaps `≤ tol · L`,
     /// where the force test never asks for less than the roundoff of the
     /// assembled forces, `ε · (EA/L)_max · |x|_max` (coordinates of tens of
     /// metres and stiff tubes put it near 1e-7 N).
@@ -286,8 +287,10 @@ impl StaticSolver {
             .fold(0.0f64, |m, v| m.max(v.abs()));
         let roundoff =
             64.0 * f64::EPSILON * (ev.internal_scale + self.system.scale * self.coordinate_scale);
-        let tol = (settings.tolerance * (self.load_scale() * lambda.abs()).max(reaction_scale))
-            .max(roundoff);
+        let force_scale = (self.load_scale() * lambda.abs())
+            .max(reaction_scale)
+            .max(ev.prestress_scale);
+        let tol = (settings.tolerance * force_scale).max(roundoff);
         (
             force,
             force <= tol && gap <= settings.tolerance * self.length_scale,
