@@ -19,9 +19,15 @@
 //!   equilibrium matrix `A(x)` of the inverse form and adjoint sensitivities;
 //! * [`uniformity`] — the tension-uniformity problem (paper eq. 5) and its
 //!   pluggable solvers (bisection, LP, gradient, least squares);
-//! * [`report`] — files a run writes (atomically): JSON, VTK.
+//! * [`mechanics`] — the multibody statics engine: geometrically exact beams,
+//!   rigid bodies, joints, cables, Newton with load steps or arc length;
+//! * [`truss`] — the ring truss and its response oracles (rigid, linear, exact);
+//! * [`design`] — the outer loop: net design and truss response to a fixed point;
+//! * [`verify`] — the design cut to length and assembled on the flexible truss;
+//! * [`report`] — files a run writes (atomically): JSON, CSV, VTK, plots.
 #![warn(missing_docs)]
 
+pub mod design;
 pub mod fdm;
 pub mod geometry;
 pub mod mechanics;
@@ -31,6 +37,7 @@ pub mod run;
 pub mod scene;
 pub mod truss;
 pub mod uniformity;
+pub mod verify;
 
 pub use fdm::{Equilibrium, FdmError, FdmStructure};
 pub use network::{CableGroup, Network, NetworkError};
@@ -60,6 +67,12 @@ pub enum Error {
     /// An invalid frame file, or a frame that cannot be built.
     #[error(transparent)]
     Frame(#[from] mechanics::FrameFileError),
+    /// The outer design loop failed.
+    #[error(transparent)]
+    Design(#[from] design::DesignError),
+    /// The assembled verification failed.
+    #[error(transparent)]
+    Verify(#[from] verify::VerifyError),
 }
 
 impl Error {
@@ -73,6 +86,11 @@ impl Error {
             Error::Report(e) => e.is_bad_input(),
             Error::Truss(e) => e.is_bad_input(),
             Error::Frame(e) => e.is_bad_input(),
+            Error::Design(e) => e.is_bad_input(),
+            Error::Verify(e) => matches!(
+                e,
+                verify::VerifyError::Mechanics(mechanics::MechanicsError::Invalid { .. })
+            ),
         }
     }
 }

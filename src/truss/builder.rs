@@ -32,12 +32,39 @@ fn v(p: &[f64; 3]) -> Vector3<f64> {
     Vector3::new(p[0], p[1], p[2])
 }
 
+/// The ring-truss frame before it is built, so that more items (the net's
+/// points and cables, for an assembled model) can join it.
+#[derive(Debug, Clone)]
+pub struct RingTrussBuilder {
+    /// The frame so far.
+    pub builder: ModelBuilder,
+    /// Hinge bodies: top hinges `0..N`, then bottom hinges.
+    pub attachments: Vec<NodeId>,
+    /// The supported bottom hinges and their fixed components `[x, y, z]`.
+    pub supports: Vec<(usize, [bool; 3])>,
+}
+
 impl RingTruss {
     /// The frame of `scene`'s truss on the hinge layout `layout`.
     ///
     /// # Errors
     /// A degenerate layout (coincident hinges), named.
     pub fn new(scene: &Scene, layout: &RingTrussLayout) -> Result<Self, MechanicsError> {
+        let RingTrussBuilder {
+            builder,
+            attachments,
+            supports,
+        } = Self::builder(scene, layout);
+        Ok(RingTruss {
+            model: builder.build()?,
+            attachments,
+            supports,
+        })
+    }
+
+    /// The frame of `scene`'s truss on `layout`, not yet built (validated by
+    /// [`ModelBuilder::build`]).
+    pub fn builder(scene: &Scene, layout: &RingTrussLayout) -> RingTrussBuilder {
         let t = &scene.truss;
         let spec = RodSpec {
             section: Section::tube(
@@ -96,11 +123,11 @@ impl RingTruss {
             );
         }
         let attachments = top_hinges.into_iter().chain(bottom_hinges).collect();
-        Ok(RingTruss {
-            model: b.build()?,
+        RingTrussBuilder {
+            builder: b,
             attachments,
             supports,
-        })
+        }
     }
 }
 

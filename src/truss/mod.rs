@@ -15,7 +15,7 @@ mod linear;
 mod rigid;
 mod scene_response;
 
-pub use builder::RingTruss;
+pub use builder::{RingTruss, RingTrussBuilder};
 pub use exact::ExactTruss;
 pub use linear::LinearTruss;
 pub use rigid::RigidTruss;

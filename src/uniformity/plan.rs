@@ -16,6 +16,10 @@
 //!   holds on the same plan grid, and vertical equilibrium with the ties holds
 //!   for one `α` (`F_rear/F` for two paraboloids), fitted by least squares.
 //!
+//! The rear net may also be absent, every tie anchored at a fixed node below
+//! its front node (the front stage of the outer design loop, see
+//! `design::TiedNets`): then the completion is the ties alone.
+//!
 //! The plan LP relaxes the full LP (it keeps a subset of its constraints), so a
 //! completion that balances every free node and respects every bound proves its
 //! optimum is the full optimum. [`PlanReduction::complete`] checks exactly that
@@ -36,6 +40,8 @@ const COMPLETION_TOLERANCE: f64 = 1e-9;
 pub(crate) struct PlanReduction {
     /// Front-net cables `0..n_front_cables`; rear cable `k + n_front_cables`.
     n_front_cables: usize,
+    /// False when every tie ends at a fixed anchor (no rear net).
+    rear: bool,
     /// Each tie: (cable, front node, rear node).
     ties: Vec<(usize, usize, usize)>,
     /// The plan LP over the front-net cables.
@@ -54,17 +60,21 @@ impl PlanReduction {
             x.hypot(y) <= VERTICAL * z.abs()
         };
         let n_ties = (0..m).rev().take_while(|&k| is_vertical(k)).count();
-        if n_ties == 0 || (m - n_ties) % 2 != 0 {
+        let structure = problem.structure();
+        let edges = &network.edges;
+        let rear = !edges[m - n_ties..]
+            .iter()
+            .all(|&[_, r]| structure.free_index(r).is_none());
+        if n_ties == 0 || (rear && (m - n_ties) % 2 != 0) {
             return Err(
                 "the network does not end with the vertical ties of a reflector mesh".into(),
             );
         }
-        let n = (m - n_ties) / 2;
-        let offset = network.edges[2 * n][1].wrapping_sub(network.edges[2 * n][0]);
-        let structure = problem.structure();
-        let edges = &network.edges;
+        let n = if rear { (m - n_ties) / 2 } else { m - n_ties };
+        let first_tie = m - n_ties;
+        let offset = edges[first_tie][1].wrapping_sub(edges[first_tie][0]);
         if let Some(k) = (0..n).find(|&k| {
-            is_vertical(k) || edges[k + n] != [edges[k][0] + offset, edges[k][1] + offset]
+            is_vertical(k) || (rear && edges[k + n] != [edges[k][0] + offset, edges[k][1] + offset])
         }) {
             return Err(format!(
                 "cable {} is not the rear-net mirror of front-net cable {k}",
@@ -86,8 +96,8 @@ impl PlanReduction {
         }
         let mut tied = vec![false; n_free];
         let mut ties = Vec::with_capacity(n_ties);
-        for (k, &[i, r]) in edges.iter().enumerate().skip(2 * n) {
-            let Some(f) = local[i].filter(|_| r == i + offset) else {
+        for (k, &[i, r]) in edges.iter().enumerate().skip(first_tie) {
+            let Some(f) = local[i].filter(|_| !rear || r == i + offset) else {
                 return Err(format!(
                     "tie {k} does not join a front node to the node below it"
                 ));
@@ -116,6 +126,7 @@ impl PlanReduction {
         };
         Ok(PlanReduction {
             n_front_cables: n,
+            rear,
             ties,
             lp,
         })
@@ -141,26 +152,26 @@ impl PlanReduction {
         let mut q = vec![0.0; m];
         q[..n].copy_from_slice(q_front);
 
-        // Vertical pull of a net at every node: Σ_j q_ij (z_j − z_i).
-        let pull = |range: std::ops::Range<usize>, q: &[f64]| {
-            let mut v = vec![0.0; network.n_nodes()];
-            for k in range {
-                let [i, j] = network.edges[k];
-                let f = q[k] * (x[j][2] - x[i][2]);
-                v[i] += f;
-                v[j] -= f;
-            }
-            v
-        };
-        let front_pull = pull(0..n, &q);
+        let front_pull = vertical_pull(network, 0..n, &q);
         for &(k, i, r) in &self.ties {
             q[k] = front_pull[i] / (x[i][2] - x[r][2]);
         }
+        if self.rear {
+            self.complete_rear(network, &mut q)?;
+        }
+        self.check(problem, q)
+    }
+
+    /// The rear net `q_rear = α q_front`, α from the rear nodes' vertical
+    /// balance against the ties (least squares).
+    fn complete_rear(&self, network: &crate::Network, q: &mut [f64]) -> Result<(), String> {
+        let n = self.n_front_cables;
+        let x = &network.nodes;
         // α from the rear nodes' vertical balance: α V_r + q_t (z_i − z_r) = 0.
         for k in 0..n {
             q[k + n] = q[k];
         }
-        let rear_pull = pull(n..2 * n, &q);
+        let rear_pull = vertical_pull(network, n..2 * n, q);
         let (mut num, mut den) = (0.0, 0.0);
         for &(k, i, r) in &self.ties {
             let tie = q[k] * (x[i][2] - x[r][2]);
@@ -175,7 +186,14 @@ impl PlanReduction {
             ));
         }
         q[n..2 * n].iter_mut().for_each(|v| *v *= alpha);
+        Ok(())
+    }
 
+    /// `q` if it balances the prescribed geometry and keeps the full LP's
+    /// bounds, else why not.
+    fn check(&self, problem: &UniformityProblem, q: Vec<f64>) -> Result<Vec<f64>, String> {
+        let n = self.n_front_cables;
+        let m = q.len();
         let lengths = problem.lengths_m();
         let tensions: Vec<f64> = q.iter().zip(lengths).map(|(q, l)| q * l).collect();
         let max_tension = tensions.iter().copied().fold(0.0, f64::max);
@@ -196,4 +214,17 @@ impl PlanReduction {
         }
         Ok(q)
     }
+}
+
+/// Vertical pull of the cables `range` at every node: `Σ_j q_ij (z_j − z_i)`.
+fn vertical_pull(network: &crate::Network, range: std::ops::Range<usize>, q: &[f64]) -> Vec<f64> {
+    let x = &network.nodes;
+    let mut v = vec![0.0; network.n_nodes()];
+    for k in range {
+        let [i, j] = network.edges[k];
+        let f = q[k] * (x[j][2] - x[i][2]);
+        v[i] += f;
+        v[j] -= f;
+    }
+    v
 }

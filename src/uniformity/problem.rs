@@ -144,6 +144,69 @@ impl UniformityProblem {
         )
     }
 
+    /// The same problem with the fixed nodes moved to `positions_m` (one per
+    /// entry of the network's `fixed`, in that order): the boundary `C_k` of an
+    /// outer design iteration (paper §4). The free nodes keep their prescribed
+    /// positions; the factorisation structure is reused.
+    ///
+    /// # Errors
+    /// A count that does not match, a non-finite position, or a cable that
+    /// the move makes zero-length (named).
+    pub fn with_boundary(&self, positions_m: &[[f64; 3]]) -> Result<Self, UniformityError> {
+        let fixed = &self.network.fixed;
+        if positions_m.len() != fixed.len() {
+            return Err(UniformityError::Invalid(format!(
+                "boundary: {} positions for {} fixed nodes",
+                positions_m.len(),
+                fixed.len()
+            )));
+        }
+        let mut nodes = self.network.nodes.clone();
+        for (&i, p) in fixed.iter().zip(positions_m) {
+            nodes[i] = *p;
+        }
+        self.with_positions(nodes)
+    }
+
+    /// The same problem on new prescribed positions of every node (n_nodes × 3);
+    /// the factorisation structure is reused.
+    ///
+    /// # Errors
+    /// A count that does not match, a non-finite position, or a zero-length
+    /// cable (named).
+    pub fn with_positions(&self, nodes_m: Vec<[f64; 3]>) -> Result<Self, UniformityError> {
+        if nodes_m.len() != self.network.n_nodes() {
+            return Err(UniformityError::Invalid(format!(
+                "{} positions for {} nodes",
+                nodes_m.len(),
+                self.network.n_nodes()
+            )));
+        }
+        if let Some(i) = nodes_m
+            .iter()
+            .position(|p| !p.iter().all(|v| v.is_finite()))
+        {
+            return Err(UniformityError::Invalid(format!(
+                "the position of node {i} is not finite"
+            )));
+        }
+        let mut moved = self.clone();
+        moved.network.nodes = nodes_m;
+        moved.lengths_m = moved
+            .network
+            .edges_vectors()
+            .into_iter()
+            .map(norm3)
+            .collect();
+        if let Some(k) = moved.lengths_m.iter().position(|&l| !(l > 0.0)) {
+            return Err(UniformityError::Invalid(format!(
+                "cable {k} (nodes {:?}) has zero length in the prescribed geometry",
+                moved.network.edges[k]
+            )));
+        }
+        Ok(moved)
+    }
+
     /// The network: prescribed positions, cables, supports, loads, groups.
     pub fn network(&self) -> &Network {
         &self.network

@@ -1,0 +1,364 @@
+//! The net design for one boundary of the outer loop: a front net on the
+//! paraboloid, vertical ties, and a rear net whose shape is free (DESIGN §4, §6).
+//!
+//! On the theoretical boundary the rear net mirrors the front net in plan and
+//! the whole network has one prescribed geometry. A deformed truss moves the
+//! top and bottom hinges differently; keeping the rear net's prescribed
+//! geometry then forces wildly non-uniform tensions (measured on `small-hex`:
+//! front ratio 1.19 → 8.1 for a 1.5 mm hinge motion), although nothing asks
+//! for the rear shape. So each design is made in two stages:
+//!
+//! 1. **front**: the uniformity problem of the front net with vertical ties —
+//!    front free nodes on the paraboloid, top hinges at the boundary `C`, each
+//!    tie anchored directly below its node; any
+//!    [`UniformitySolver`](crate::uniformity::UniformitySolver) solves it. A
+//!    vertical tie carries no plan force, so this stage does not depend on the
+//!    rear net at all;
+//! 2. **rear**: the rear net keeps its plan (the front net's, so the ties stay
+//!    vertical) with its bottom hinges at `C`; its force densities are the
+//!    closest to the mirror `α q_front` (relative least squares) that balance
+//!    the plan, `min Σ ((q − q₀)/q₀)²` s.t. `A_plan q = 0`, `q₀ = α q_front`;
+//!    then the tie forces, as vertical loads, give the rear nodes' heights by
+//!    one forward force density solve, and the ties' force densities follow
+//!    from their new lengths. `α` is fitted to the vertical balance of the
+//!    nominal rear net (`α = F_rear/F` for two paraboloids), so the rear shape
+//!    stays near its nominal paraboloid.
+//!
+//! Every node then balances exactly, for any boundary: the outer loop iterates
+//! on the boundary alone, as the paper's.
+
+use std::time::Instant;
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Side};
+
+use crate::fdm::FdmStructure;
+use crate::geometry::ReflectorMesh;
+use crate::network::{CableGroup, Network};
+use crate::uniformity::{
+    Design, UniformityError, UniformityProblem, UniformitySet, UniformitySolver,
+};
+
+/// A reflector's front net, rear net and ties, split for the two-stage design.
+#[derive(Debug, Clone)]
+pub struct TiedNets {
+    /// The whole network's problem (the scene's sets, surface and bounds).
+    full: UniformityProblem,
+    /// Front net + vertical ties to anchors below their nodes.
+    front: UniformityProblem,
+    /// Rear net alone (rear node `i` of the whole network is `i − n_front`).
+    rear: FdmStructure,
+    /// Nodes of the front net.
+    n_front: usize,
+    /// Number of front-net cables (the rear mirror of cable `k` is `k + n`).
+    n_front_cables: usize,
+    /// Each tie: (cable, front node, rear node) in the whole network.
+    ties: Vec<(usize, usize, usize)>,
+}
+
+/// A two-stage design on one boundary.
+#[derive(Debug, Clone)]
+pub struct TiedDesign {
+    /// The whole network's design (forward solve of every node with all `q`).
+    pub design: Design,
+    /// The whole network's problem at the geometry designed for.
+    pub problem: UniformityProblem,
+    /// The rear level `α = q_rear/q_front` of the mirror.
+    pub alpha: f64,
+}
+
+fn invalid(reason: impl Into<String>) -> UniformityError {
+    UniformityError::Invalid(reason.into())
+}
+
+impl TiedNets {
+    /// The split of `mesh`'s network; `full` is the scene's uniformity problem
+    /// on that network (its sets must lie in the front net).
+    ///
+    /// # Errors
+    /// A network that is not a reflector mesh (front, mirrored rear, vertical
+    /// ties), or a uniformity set with rear-net cables.
+    pub fn new(mesh: &ReflectorMesh, full: UniformityProblem) -> Result<Self, UniformityError> {
+        let network = full.network();
+        let groups = &mesh.groups;
+        let is_front = |g: CableGroup| matches!(g, CableGroup::Front | CableGroup::Boundary);
+        let n_front_cables = groups.iter().take_while(|&&g| is_front(g)).count();
+        let n_front = mesh.n_front_nodes;
+        let ties: Vec<(usize, usize, usize)> = (0..network.n_edges())
+            .filter(|&k| groups[k] == CableGroup::Tie)
+            .map(|k| {
+                let [a, b] = network.edges[k];
+                (k, a.min(b), a.max(b))
+            })
+            .collect();
+        let mirrored = (0..n_front_cables).all(|k| {
+            let [i, j] = network.edges[k];
+            network.edges.get(k + n_front_cables) == Some(&[i + n_front, j + n_front])
+        });
+        let vertical = ties.iter().all(|&(_, i, r)| {
+            r == i + n_front && {
+                let (a, b) = (network.nodes[i], network.nodes[r]);
+                a[0] == b[0] && a[1] == b[1]
+            }
+        });
+        if !mirrored || !vertical || 2 * n_front_cables + ties.len() != network.n_edges() {
+            return Err(invalid(
+                "the network is not a reflector mesh (front net, mirrored rear net, vertical ties)",
+            ));
+        }
+        if let Some(set) = full
+            .sets()
+            .iter()
+            .find(|s| s.edges.iter().any(|&k| k >= n_front_cables))
+        {
+            return Err(invalid(format!(
+                "uniformity set `{}` has cables outside the front net: the outer loop designs \
+                 the front net and lets the rear net follow (q_rear ≈ α q_front)",
+                set.name
+            )));
+        }
+
+        // Stage 1: front nodes 0..n_front, then one anchor per tie.
+        let label = |k: usize| network.group_of(k).to_string();
+        let mut nodes = network.nodes[..n_front].to_vec();
+        let mut edges = network.edges[..n_front_cables].to_vec();
+        let mut q = network.q[..n_front_cables].to_vec();
+        let mut labels: Vec<String> = (0..n_front_cables).map(label).collect();
+        let mut fixed = mesh.front_attachments.clone();
+        for (t, &(k, i, r)) in ties.iter().enumerate() {
+            nodes.push(network.nodes[r]);
+            edges.push([i, n_front + t]);
+            q.push(network.q[k]);
+            labels.push(label(k));
+            fixed.push(n_front + t);
+        }
+        let front_network = Network {
+            nodes,
+            edges,
+            fixed,
+            q,
+            loads: None,
+            groups: Some(labels),
+        };
+        let sets: Vec<UniformitySet> = full.sets().to_vec();
+        let mut front = UniformityProblem::new(
+            front_network,
+            sets,
+            full.surface_nodes().to_vec(),
+            full.surface(),
+            full.max_force_density_n_per_m,
+        )?;
+        front.min_tension_fraction = full.min_tension_fraction;
+
+        // Stage 2: the rear net alone.
+        let rear_network = Network {
+            nodes: network.nodes[n_front..].to_vec(),
+            edges: network.edges[n_front_cables..2 * n_front_cables]
+                .iter()
+                .map(|&[i, j]| [i - n_front, j - n_front])
+                .collect(),
+            fixed: mesh.rear_attachments.iter().map(|&i| i - n_front).collect(),
+            q: network.q[n_front_cables..2 * n_front_cables].to_vec(),
+            loads: None,
+            groups: None,
+        };
+        let rear = FdmStructure::new(&rear_network)?;
+        Ok(TiedNets {
+            full,
+            front,
+            rear,
+            n_front,
+            n_front_cables,
+            ties,
+        })
+    }
+
+    /// The whole network's problem on the theoretical boundary.
+    pub fn problem(&self) -> &UniformityProblem {
+        &self.full
+    }
+
+    /// The two-stage design for attachment points `boundary_m` (top hinges,
+    /// then bottom hinges: the order of the network's fixed nodes).
+    ///
+    /// # Errors
+    /// A boundary of the wrong size, a stage that fails, rear force densities
+    /// that cannot stay positive, or a tie that would have to push (named).
+    pub fn design(
+        &self,
+        solver: &dyn UniformitySolver,
+        boundary_m: &[[f64; 3]],
+    ) -> Result<TiedDesign, UniformityError> {
+        let clock = Instant::now();
+        let network = self.full.network();
+        if boundary_m.len() != network.fixed.len() {
+            return Err(invalid(format!(
+                "{} boundary points given, {} attachment points expected",
+                boundary_m.len(),
+                network.fixed.len()
+            )));
+        }
+        let (n_front, n) = (self.n_front, self.n_front_cables);
+        let mut whole = network.nodes.clone();
+        for (&i, p) in network.fixed.iter().zip(boundary_m) {
+            whole[i] = *p;
+        }
+
+        // Stage 1: the front net with vertical ties.
+        let mut front_nodes = whole[..n_front].to_vec();
+        front_nodes.extend(self.ties.iter().map(|&(_, _, r)| whole[r]));
+        let front = self.front.with_positions(front_nodes)?;
+        let front_design = solver.solve(&front)?;
+        let q_front = &front_design.q;
+
+        // Stage 2: rear force densities balancing the plan, then heights.
+        let alpha = self.alpha(q_front);
+        let rear_plan: Vec<[f64; 3]> = whole[n_front..].iter().map(|p| [p[0], p[1], 0.0]).collect();
+        let mirror: Vec<f64> = q_front[..n].iter().map(|q| alpha * q).collect();
+        let q_rear = self.balance_plan(&rear_plan, &mirror)?;
+        let mut loads = vec![[0.0; 3]; rear_plan.len()];
+        for (t, &(_, _, r)) in self.ties.iter().enumerate() {
+            loads[r - n_front][2] = front_design.tensions_n[n + t];
+        }
+        let rear_nodes = whole[n_front..].to_vec();
+        let rear = self.rear.solve(&q_rear, &rear_nodes, Some(&loads))?;
+        for &i in self.rear.free_nodes() {
+            whole[n_front + i] = rear.nodes_xyz_m[i];
+        }
+        let mut q = vec![0.0; network.n_edges()];
+        q[..n].copy_from_slice(&q_front[..n]);
+        q[n..2 * n].copy_from_slice(&q_rear);
+        for (t, &(k, i, r)) in self.ties.iter().enumerate() {
+            let length = whole[i][2] - whole[r][2];
+            if !(length > 0.0) {
+                return Err(invalid(format!(
+                    "tie {k}: the rear node {r} rises to {:.4} m, above front node {i} at \
+                     {:.4} m — the rear net is too slack for this boundary",
+                    whole[r][2], whole[i][2]
+                )));
+            }
+            q[k] = front_design.tensions_n[n + t] / length;
+        }
+
+        // The whole network at its new geometry, judged by one forward solve.
+        let problem = self.full.with_positions(whole)?;
+        let design = Design::evaluate(
+            &problem,
+            &front_design.solver,
+            q,
+            front_design.termination,
+            front_design.iterations,
+            clock.elapsed(),
+            front_design.warnings,
+        )?;
+        Ok(TiedDesign {
+            design,
+            problem,
+            alpha,
+        })
+    }
+
+    /// The rear level `α` that best balances the nominal rear net vertically
+    /// against the ties of `q_front` (least squares over rear free nodes):
+    /// `α Σ_j q_f (z_j − z_i) + t_i = 0` at rear node `i`.
+    fn alpha(&self, q_front: &[f64]) -> f64 {
+        let x = &self.full.network().nodes;
+        let n = self.n_front_cables;
+        let edges = &self.full.network().edges;
+        let (mut a, mut b) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+        for k in 0..n {
+            let [i, j] = edges[k + n];
+            let pull = q_front[k] * (x[j][2] - x[i][2]);
+            a[i] += pull;
+            a[j] -= pull;
+        }
+        for (t, &(_, i, r)) in self.ties.iter().enumerate() {
+            b[r] += q_front[n + t] * (x[i][2] - x[r][2]);
+        }
+        let (mut ab, mut aa) = (0.0, 0.0);
+        for &i in self.rear.free_nodes() {
+            let i = i + self.n_front;
+            ab += a[i] * b[i];
+            aa += a[i] * a[i];
+        }
+        -ab / aa
+    }
+
+    /// The force densities closest to `q0` (relative least squares) in plan
+    /// equilibrium at the rear free nodes: `q = q₀ − Q₀² Aᵀ μ`,
+    /// `(A Q₀² Aᵀ) μ = A q₀`, `A` the plan equilibrium matrix (2 rows per
+    /// free node; sparse Cholesky, one refinement step).
+    fn balance_plan(&self, plan: &[[f64; 3]], q0: &[f64]) -> Result<Vec<f64>, UniformityError> {
+        let structure = &self.rear;
+        let rows = 2 * structure.free_nodes().len();
+        let column = |k: usize| {
+            let [i, j] = structure.edges()[k];
+            let u = [plan[i][0] - plan[j][0], plan[i][1] - plan[j][1]];
+            let mut entries = Vec::with_capacity(4);
+            for (node, sign) in [(i, 1.0), (j, -1.0)] {
+                if let Some(f) = structure.free_index(node) {
+                    entries.push((2 * f, sign * u[0]));
+                    entries.push((2 * f + 1, sign * u[1]));
+                }
+            }
+            entries
+        };
+        let a_times = |q: &[f64]| {
+            let mut r = vec![0.0; rows];
+            for (k, &qk) in q.iter().enumerate() {
+                for (row, v) in column(k) {
+                    r[row] += v * qk;
+                }
+            }
+            r
+        };
+        let mut triplets = Vec::new();
+        for (k, &w) in q0.iter().enumerate() {
+            let entries = column(k);
+            for &(ra, va) in &entries {
+                for &(rb, vb) in &entries {
+                    if rb <= ra {
+                        triplets.push(Triplet::new(ra, rb, w * w * va * vb));
+                    }
+                }
+            }
+        }
+        let failed = |e: String| UniformityError::SolverFailed {
+            solver: "rear plan balance",
+            status: e,
+        };
+        let s = SparseColMat::try_new_from_triplets(rows, rows, &triplets)
+            .map_err(|e| failed(format!("{e:?}")))?;
+        let symbolic = SymbolicLlt::try_new(s.symbolic(), Side::Lower)
+            .map_err(|e| failed(format!("{e:?}")))?;
+        let llt = Llt::try_new_with_symbolic(symbolic, s.as_ref(), Side::Lower).map_err(|e| {
+            failed(format!(
+                "the rear net's plan is not stiff with its hinges ({e:?})"
+            ))
+        })?;
+        let mut q = q0.to_vec();
+        for _ in 0..2 {
+            let r = a_times(&q);
+            let mut mu = Mat::from_fn(rows, 1, |i, _| r[i]);
+            llt.solve_in_place(mu.as_mut());
+            for (k, qk) in q.iter_mut().enumerate() {
+                let at_mu: f64 = column(k).iter().map(|&(row, v)| v * mu[(row, 0)]).sum();
+                *qk -= q0[k] * q0[k] * at_mu;
+            }
+        }
+        let negative: Vec<usize> = (0..q.len()).filter(|&k| !(q[k] > 0.0)).collect();
+        if !negative.is_empty() {
+            return Err(invalid(format!(
+                "rear-net cables {:?} cannot stay in tension with the deformed bottom hinges",
+                negative
+                    .iter()
+                    .take(8)
+                    .map(|k| k + self.n_front_cables)
+                    .collect::<Vec<_>>()
+            )));
+        }
+        Ok(q)
+    }
+}

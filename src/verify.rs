@@ -1,0 +1,284 @@
+//! Verification of a design by assembly (paper §5, DESIGN §7): every cable cut
+//! to its unstressed length `L₀ = ℓ/(1 + T/EA)`, attached to the *undeformed*
+//! truss, and the whole solved to static equilibrium — what will be built.
+//!
+//! The cables are tension-only elastic elements ([`crate::mechanics::cable`]);
+//! their prestrain is ramped as load steps from the stress-free assembly
+//! (cables at the distance of their end points) to the cut lengths. The truss
+//! is either rigid (the attachment points held where the layout puts them)
+//! or the flexible ring truss of the scene (geometrically exact beams, hinges
+//! and joints, isostatic support).
+
+use std::time::Instant;
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use crate::geometry::ReflectorMesh;
+use crate::mechanics::{
+    MechanicsError, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver, StaticTermination,
+};
+use crate::network::{norm3, Network};
+use crate::scene::Scene;
+use crate::truss::{RingTruss, RingTrussBuilder};
+use crate::uniformity::Design;
+
+/// What the cables are assembled on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AssemblyTruss {
+    /// Attachment points held at the layout's hinge positions.
+    Rigid,
+    /// The scene's ring truss, geometrically exact, undeformed before assembly.
+    Flexible,
+}
+
+/// An assembly that cannot be built or solved.
+#[derive(Debug, thiserror::Error)]
+pub enum VerifyError {
+    /// The design does not belong to the network, or the network not to the mesh.
+    #[error("verification: {0}")]
+    Mismatch(String),
+    /// The assembled model is invalid (a cable of zero length, …), named.
+    #[error("assembled model: {0}")]
+    Mechanics(#[from] MechanicsError),
+    /// The assembly found no equilibrium.
+    #[error(
+        "the assembled net and truss found no equilibrium ({termination:?}, last converged \
+         prestrain factor {load_factor:.4})"
+    )]
+    NoEquilibrium {
+        /// How the static solve ended.
+        termination: StaticTermination,
+        /// The largest prestrain factor reached.
+        load_factor: f64,
+    },
+}
+
+/// The assembled equilibrium, judged against the design.
+#[derive(Debug, Clone, Serialize)]
+pub struct Verification {
+    /// The truss the cables were assembled on.
+    pub truss: AssemblyTruss,
+    /// RMS axial deviation of the front net's free nodes from the paraboloid, mm.
+    pub rms_mm: f64,
+    /// Largest axial deviation of a front-net free node from the paraboloid, mm.
+    pub max_deviation_mm: f64,
+    /// Largest `|T − T_design|/T_design` over all cables, %.
+    pub max_tension_change_pct: f64,
+    /// Largest distance of an attachment point from the boundary the design
+    /// assumed, mm.
+    pub boundary_deviation_mm: f64,
+    /// Largest distance of a free net node from its designed position, mm.
+    pub max_node_shift_mm: f64,
+    /// Cables not longer than their cut length at equilibrium.
+    pub slack_cables: Vec<usize>,
+    /// Newton iterations of the assembly solve.
+    pub newton_iterations: usize,
+    /// Load (prestrain) steps.
+    pub load_steps: usize,
+    /// Wall time of building and solving the assembly, s.
+    pub time_s: f64,
+    /// Assembled positions of the net's nodes, m: n_nodes × 3.
+    #[serde(skip)]
+    pub nodes_xyz_m: Vec<[f64; 3]>,
+    /// Assembled cable tensions, N: n_edges.
+    #[serde(skip)]
+    pub tensions_n: Vec<f64>,
+    /// The deformed truss as straight segments between beam nodes, m.
+    #[serde(skip)]
+    pub truss_segments_m: Vec<[[f64; 3]; 2]>,
+}
+
+fn vector(p: &[f64; 3]) -> Vector3<f64> {
+    Vector3::new(p[0], p[1], p[2])
+}
+
+fn array(v: &Vector3<f64>) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+/// Assemble `design` (made on `network`, whose fixed nodes are the attachment
+/// points in the truss's order and sit on the boundary the design assumed) on
+/// `truss`, and solve.
+///
+/// # Errors
+/// A design of another network, an invalid assembly (named), or no
+/// equilibrium.
+pub fn verify(
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    network: &Network,
+    design: &Design,
+    truss: AssemblyTruss,
+) -> Result<Verification, VerifyError> {
+    let clock = Instant::now();
+    let n_edges = network.n_edges();
+    if design.q.len() != n_edges || design.nodes_xyz_m.len() != network.n_nodes() {
+        return Err(VerifyError::Mismatch(format!(
+            "the design has {} cables and {} nodes, the network {} and {}",
+            design.q.len(),
+            design.nodes_xyz_m.len(),
+            n_edges,
+            network.n_nodes()
+        )));
+    }
+    let layout = &mesh.truss;
+    let hinges: Vec<[f64; 3]> = layout
+        .top_m
+        .iter()
+        .chain(&layout.bottom_m)
+        .copied()
+        .collect();
+    if network.fixed.len() != hinges.len() {
+        return Err(VerifyError::Mismatch(format!(
+            "the network has {} fixed nodes, the truss {} attachment points",
+            network.fixed.len(),
+            hinges.len()
+        )));
+    }
+
+    let (mut b, attachments) = match truss {
+        AssemblyTruss::Rigid => {
+            let mut b = ModelBuilder::new();
+            let points = hinges
+                .iter()
+                .map(|p| {
+                    let n = b.add_point(vector(p));
+                    b.fix(n, [true; 6]);
+                    n
+                })
+                .collect::<Vec<_>>();
+            (b, points)
+        }
+        AssemblyTruss::Flexible => {
+            let RingTrussBuilder {
+                builder,
+                attachments,
+                ..
+            } = RingTruss::builder(scene, layout);
+            (builder, attachments)
+        }
+    };
+    // Net node → model node: attachments for the fixed ones, new points for the
+    // free ones at their designed positions.
+    let mut node_of: Vec<Option<NodeId>> = vec![None; network.n_nodes()];
+    for (k, &i) in network.fixed.iter().enumerate() {
+        node_of[i] = Some(attachments[k]);
+    }
+    for (i, slot) in node_of.iter_mut().enumerate() {
+        if slot.is_none() {
+            *slot = Some(b.add_point(vector(&design.nodes_xyz_m[i])));
+        }
+    }
+    let node_of: Vec<NodeId> = node_of
+        .into_iter()
+        .map(|n| n.expect("every node mapped"))
+        .collect();
+    let ea = scene.cables.axial_stiffness_n();
+    for (k, &[i, j]) in network.edges.iter().enumerate() {
+        let (a, c) = (node_of[i], node_of[j]);
+        let start = match (b.frame(a), b.frame(c)) {
+            (Some(fa), Some(fc)) => (fc.position_m - fa.position_m).norm(),
+            _ => 0.0,
+        };
+        let cut = scene
+            .cables
+            .cut_length_m(design.lengths_m[k], design.tensions_n[k]);
+        b.add_cable(a, c, ea, [start, cut]);
+    }
+    let model = b.build()?;
+    let solver = StaticSolver::new(model)?;
+    let settings = StaticSettings {
+        tolerance: 1e-12,
+        ..StaticSettings::default()
+    };
+    let solution = solver.solve(&settings)?;
+    if !solution.converged() {
+        return Err(VerifyError::NoEquilibrium {
+            termination: solution.termination,
+            load_factor: solution.load_factor,
+        });
+    }
+    let model = solver.model();
+    let frames = &solution.state.frames;
+    let nodes_xyz_m: Vec<[f64; 3]> = node_of
+        .iter()
+        .map(|&n| array(&frames[n].position_m))
+        .collect();
+    let (tensions_n, slack_cables) = cable_tensions(model, frames);
+
+    let fixed = network.fixed_mask();
+    let surface: Vec<usize> = (0..mesh.n_front_nodes).filter(|&i| !fixed[i]).collect();
+    let deviations: Vec<f64> = surface
+        .iter()
+        .map(|&i| mesh.paraboloid.axial_deviation(nodes_xyz_m[i]))
+        .collect();
+    let rms =
+        (deviations.iter().map(|d| d * d).sum::<f64>() / deviations.len().max(1) as f64).sqrt();
+    let distance = |p: &[f64; 3], q: &[f64; 3]| norm3(std::array::from_fn(|c| p[c] - q[c]));
+    let boundary = network
+        .fixed
+        .iter()
+        .map(|&i| distance(&nodes_xyz_m[i], &network.nodes[i]))
+        .fold(0.0, f64::max);
+    let shift = (0..network.n_nodes())
+        .filter(|&i| !fixed[i])
+        .map(|i| distance(&nodes_xyz_m[i], &design.nodes_xyz_m[i]))
+        .fold(0.0, f64::max);
+    let change = tensions_n
+        .iter()
+        .zip(&design.tensions_n)
+        .map(|(t, d)| ((t - d) / d).abs())
+        .fold(0.0, f64::max);
+    let truss_segments_m = model
+        .rods()
+        .iter()
+        .flat_map(|rod| {
+            rod.nodes
+                .windows(2)
+                .map(|w| {
+                    [
+                        array(&frames[w[0]].position_m),
+                        array(&frames[w[1]].position_m),
+                    ]
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    Ok(Verification {
+        truss,
+        rms_mm: 1e3 * rms,
+        max_deviation_mm: 1e3 * deviations.iter().map(|d| d.abs()).fold(0.0, f64::max),
+        max_tension_change_pct: 100.0 * change,
+        boundary_deviation_mm: 1e3 * boundary,
+        max_node_shift_mm: 1e3 * shift,
+        slack_cables,
+        newton_iterations: solution.newton_iterations,
+        load_steps: solution.steps.len(),
+        time_s: clock.elapsed().as_secs_f64(),
+        nodes_xyz_m,
+        tensions_n,
+        truss_segments_m,
+    })
+}
+
+/// Tension of every cable of `model` at `frames` (full prestrain), and the
+/// slack ones.
+fn cable_tensions(model: &Model, frames: &[crate::mechanics::Frame]) -> (Vec<f64>, Vec<usize>) {
+    let mut slack = Vec::new();
+    let tensions = model
+        .cables()
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let [a, b] = c.nodes();
+            let s = c.state(&frames[a].position_m, &frames[b].position_m, 1.0);
+            if s.slack {
+                slack.push(k);
+            }
+            s.tension_n
+        })
+        .collect();
+    (tensions, slack)
+}
