@@ -15,12 +15,13 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::geometry::ReflectorMesh;
+use crate::mechanics::State;
 use crate::mechanics::{
     MechanicsError, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver, StaticTermination,
 };
 use crate::network::{norm3, Network};
 use crate::scene::Scene;
-use crate::truss::{RingTruss, RingTrussBuilder};
+use crate::truss::{ExactTruss, RingTruss, RingTrussBuilder, TrussOracle};
 use crate::uniformity::Design;
 
 /// What the cables are assembled on.
@@ -176,6 +177,7 @@ pub fn verify(
         .map(|n| n.expect("every node mapped"))
         .collect();
     let ea = scene.cables.axial_stiffness_n();
+    let mut ramped = b.clone();
     for (k, &[i, j]) in network.edges.iter().enumerate() {
         let (a, c) = (node_of[i], node_of[j]);
         let start = match (b.frame(a), b.frame(c)) {
@@ -185,15 +187,36 @@ pub fn verify(
         let cut = scene
             .cables
             .cut_length_m(design.lengths_m[k], design.tensions_n[k]);
-        b.add_cable(a, c, ea, [start, cut]);
+        b.add_cable(a, c, ea, [cut, cut]);
+        ramped.add_cable(a, c, ea, [start, cut]);
     }
-    let model = b.build()?;
-    let solver = StaticSolver::new(model)?;
     let settings = StaticSettings {
         tolerance: 1e-12,
         ..StaticSettings::default()
     };
-    let solution = solver.solve(&settings)?;
+    // First from the truss as the design's pull deforms it (the equilibrium
+    // sought is near: Newton from the undeformed truss can diverge, the hinge
+    // motion being many times the cables' elastic stretch); then, if that
+    // fails, from the undeformed truss with the prestrain ramped in load steps.
+    let mut found = None;
+    if let Some(guess) = truss_guess(scene, mesh, design, truss)? {
+        let solver = StaticSolver::new(b.build()?)?;
+        let mut start = solver.reference_state();
+        start.frames[..guess.frames.len()].copy_from_slice(&guess.frames);
+        start.set_multipliers(&guess);
+        let s = solver.solve_from(start, 0.0, &settings)?;
+        if s.converged() {
+            found = Some((solver, s));
+        }
+    }
+    let (solver, solution) = match found {
+        Some(found) => found,
+        None => {
+            let solver = StaticSolver::new(ramped.build()?)?;
+            let s = solver.solve(&settings)?;
+            (solver, s)
+        }
+    };
     if !solution.converged() {
         return Err(VerifyError::NoEquilibrium {
             termination: solution.termination,
@@ -260,6 +283,28 @@ pub fn verify(
         nodes_xyz_m,
         tensions_n,
         truss_segments_m,
+    })
+}
+
+/// The flexible truss's equilibrium under the design's pull (`None` for a
+/// rigid assembly, or when the truss finds none): the start of the
+/// assembled solve.
+fn truss_guess(
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    design: &Design,
+    truss: AssemblyTruss,
+) -> Result<Option<State>, VerifyError> {
+    if truss == AssemblyTruss::Rigid {
+        return Ok(None);
+    }
+    let layout = &mesh.truss;
+    let mut exact = ExactTruss::new(RingTruss::new(scene, layout)?, layout)
+        .map_err(|e| VerifyError::Mismatch(e.to_string()))?;
+    let pull: Vec<[f64; 3]> = design.reactions_n.iter().map(|r| r.map(|v| -v)).collect();
+    Ok(match exact.respond(&pull) {
+        Ok(_) => exact.state().cloned(),
+        Err(_) => None,
     })
 }
 

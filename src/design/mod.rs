@@ -50,7 +50,7 @@ impl Default for LoopSettings {
             relaxation: Relaxation::default(),
             tolerance_m: 1e-6,
             max_iterations: 50,
-            anderson_depth: 5,
+            anderson_depth: 10,
         }
     }
 }

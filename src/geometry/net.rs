@@ -46,6 +46,30 @@ pub struct ReflectorMesh {
     pub aperture: Aperture,
     /// The ring-truss hinge points.
     pub truss: RingTrussLayout,
+    /// Rings of the sector subdivision.
+    pub rings: usize,
+    /// Inward sag of the free boundary, as a fraction of the bay chord.
+    pub boundary_sag_ratio: f64,
+}
+
+impl ReflectorMesh {
+    /// The front net's plan grid rebuilt, by the same construction, on top
+    /// hinges at `top_m` (their plan positions; the centre stays): the design
+    /// geometry for a deformed truss, whose nodes move with the hinges.
+    ///
+    /// # Panics
+    /// If `top_m` does not hold one point per bay.
+    #[track_caller]
+    pub fn front_plan(&self, top_m: &[[f64; 3]]) -> Vec<[f64; 2]> {
+        assert_eq!(top_m.len(), self.truss.bays(), "one top hinge per bay");
+        let vertex: Vec<[f64; 2]> = top_m.iter().map(|p| [p[0], p[1]]).collect();
+        grid_points(
+            self.aperture.centre(),
+            &vertex,
+            self.rings,
+            self.boundary_sag_ratio,
+        )
+    }
 }
 
 /// Plan grid of the sector subdivision: positions and cables of one net.
@@ -69,34 +93,9 @@ fn node_index(bays: usize, i: usize, k: usize, j: usize) -> usize {
 }
 
 fn plan_grid(aperture: &Aperture, bays: usize, rings: usize, sag_ratio: f64) -> PlanGrid {
-    let c = aperture.centre();
     let angle = |k: usize| std::f64::consts::TAU * (k % bays) as f64 / bays as f64;
     let vertex: Vec<[f64; 2]> = (0..bays).map(|k| aperture.rim_point(angle(k))).collect();
-    let n_points = 1 + bays * rings * (rings + 1) / 2;
-    let mut points = vec![c; n_points];
-    let n = rings as f64;
-    for i in 1..=rings {
-        for k in 0..bays {
-            let (a, b) = (vertex[k], vertex[(k + 1) % bays]);
-            let chord = [b[0] - a[0], b[1] - a[1]];
-            let chord_length = chord[0].hypot(chord[1]);
-            // Unit normal to the chord, pointing to the centre.
-            let inward = [chord[1] / chord_length, -chord[0] / chord_length];
-            let inward = if (c[0] - a[0]) * inward[0] + (c[1] - a[1]) * inward[1] >= 0.0 {
-                inward
-            } else {
-                [-inward[0], -inward[1]]
-            };
-            for j in 0..i {
-                let (fi, fj) = (i as f64 / n, j as f64 / n);
-                let s = j as f64 / i as f64;
-                let sag = sag_ratio * chord_length * (i as f64 / n) * 4.0 * s * (1.0 - s);
-                points[node_index(bays, i, k, j)] = std::array::from_fn(|d| {
-                    c[d] + fi * (a[d] - c[d]) + fj * (b[d] - a[d]) + sag * inward[d]
-                });
-            }
-        }
-    }
+    let points = grid_points(aperture.centre(), &vertex, rings, sag_ratio);
     let mut edges = Vec::new();
     let mut triangles = Vec::new();
     for k in 0..bays {
@@ -124,6 +123,38 @@ fn plan_grid(aperture: &Aperture, bays: usize, rings: usize, sag_ratio: f64) -> 
         vertices,
         triangles,
     }
+}
+
+/// Plan points of the sector subdivision of the polygon `vertex` about the
+/// centre `c` (node numbering of [`node_index`]).
+fn grid_points(c: [f64; 2], vertex: &[[f64; 2]], rings: usize, sag_ratio: f64) -> Vec<[f64; 2]> {
+    let bays = vertex.len();
+    let n_points = 1 + bays * rings * (rings + 1) / 2;
+    let mut points = vec![c; n_points];
+    let n = rings as f64;
+    for i in 1..=rings {
+        for k in 0..bays {
+            let (a, b) = (vertex[k], vertex[(k + 1) % bays]);
+            let chord = [b[0] - a[0], b[1] - a[1]];
+            let chord_length = chord[0].hypot(chord[1]);
+            // Unit normal to the chord, pointing to the centre.
+            let inward = [chord[1] / chord_length, -chord[0] / chord_length];
+            let inward = if (c[0] - a[0]) * inward[0] + (c[1] - a[1]) * inward[1] >= 0.0 {
+                inward
+            } else {
+                [-inward[0], -inward[1]]
+            };
+            for j in 0..i {
+                let (fi, fj) = (i as f64 / n, j as f64 / n);
+                let s = j as f64 / i as f64;
+                let sag = sag_ratio * chord_length * (i as f64 / n) * 4.0 * s * (1.0 - s);
+                points[node_index(bays, i, k, j)] = std::array::from_fn(|d| {
+                    c[d] + fi * (a[d] - c[d]) + fj * (b[d] - a[d]) + sag * inward[d]
+                });
+            }
+        }
+    }
+    points
 }
 
 /// Builds the nets of a scene (validated by [`Scene::read`]) and checks what
@@ -283,6 +314,8 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
         paraboloid,
         aperture,
         truss,
+        rings,
+        boundary_sag_ratio: scene.front_net.boundary_sag_ratio,
     })
 }
 

@@ -51,6 +51,19 @@ pub struct State {
     pub(crate) multipliers: Vec<f64>,
 }
 
+impl State {
+    /// Take the multipliers of the first joints from `other`, a state of a
+    /// model whose joints are the first joints of this one (a sub-model).
+    ///
+    /// # Panics
+    /// If `other` has more multipliers than this state.
+    #[track_caller]
+    pub fn set_multipliers(&mut self, other: &State) {
+        let n = other.multipliers.len();
+        self.multipliers[..n].copy_from_slice(&other.multipliers);
+    }
+}
+
 /// Residual and tangent values at a state.
 pub(crate) struct Evaluation {
     /// Residual of every unknown (forces, moments, joint equations).
@@ -86,11 +99,18 @@ impl System {
             joint_row.push(n_rows);
             n_rows += j.rows();
         }
-        // Constraint scale: the stiffest element's axial stiffness EA/L.
+        // Constraint scale: the stiffest element's or cable's axial
+        // stiffness EA/L (it also sets the roundoff floor of the forces).
         let scale = model
             .elements
             .iter()
             .map(|e| e.axial_stiffness())
+            .chain(
+                model
+                    .cables
+                    .iter()
+                    .map(|c| c.axial_n() / c.rest_length_m(0.0).min(c.rest_length_m(1.0))),
+            )
             .fold(0.0, f64::max)
             .max(1.0);
 

@@ -153,6 +153,10 @@ impl UniformitySolver for Bisection {
         "bisection"
     }
 
+    fn unique_design(&self) -> bool {
+        false
+    }
+
     fn knob(&self) -> Option<f64> {
         Some(self.epsilon_n)
     }

@@ -102,11 +102,25 @@ impl ConicProgram {
     /// are often degenerate near the optimum, so a solve that ends in a numerical
     /// failure is retried with the other LDLᵀ backend and stronger static
     /// regularisation; the outcome says which attempt answered.
-    pub(crate) fn solve(mut self, c: &[f64]) -> ConicOutcome {
+    pub(crate) fn solve(self, c: &[f64]) -> ConicOutcome {
+        self.solve_quadratic(&[], c)
+    }
+
+    /// Solves `min ½ xᵀ diag(p) x + cᵀx` subject to the rows; `p` may be
+    /// shorter than `x` (the rest of the diagonal is zero). Retries as
+    /// [`Self::solve`].
+    pub(crate) fn solve_quadratic(mut self, p_diagonal: &[f64], c: &[f64]) -> ConicOutcome {
         self.close();
         let n_rows = self.b.len();
         let a = CscMatrix::new_from_triplets(n_rows, self.n_vars, self.rows, self.cols, self.vals);
-        let p = CscMatrix::zeros((self.n_vars, self.n_vars));
+        let diagonal: Vec<usize> = (0..p_diagonal.len()).collect();
+        let p = CscMatrix::new_from_triplets(
+            self.n_vars,
+            self.n_vars,
+            diagonal.clone(),
+            diagonal,
+            p_diagonal.to_vec(),
+        );
         let mut outcome = None;
         for (attempt, (method, regularisation)) in ATTEMPTS.iter().enumerate() {
             let settings = DefaultSettingsBuilder::default()

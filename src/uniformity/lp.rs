@@ -24,6 +24,10 @@ impl UniformitySolver for Lp {
         "lp"
     }
 
+    fn unique_design(&self) -> bool {
+        false
+    }
+
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
         let start = Instant::now();
         if problem.has_loads() {

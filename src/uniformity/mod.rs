@@ -18,6 +18,7 @@ mod least_squares;
 mod lp;
 mod plan;
 mod problem;
+mod selection;
 
 pub use bisection::Bisection;
 pub use design::{Design, TensionSpread, Termination};
@@ -26,6 +27,7 @@ pub use gradient::{Gradient, History};
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
 pub use problem::{SurfaceTarget, UniformityProblem, UniformitySet};
+pub use selection::most_uniform;
 
 use crate::fdm::FdmError;
 
@@ -100,6 +102,12 @@ pub trait UniformitySolver: Send + Sync {
     }
     /// Solves the problem.
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError>;
+    /// True when the design is a unique, continuous function of the problem;
+    /// false for min-ratio programs, whose optimum is a face (see
+    /// [`most_uniform`] for a unique point of it).
+    fn unique_design(&self) -> bool {
+        true
+    }
 }
 
 /// The solvers, by name (the command line's choice).
