@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
+use ringmesh::design::Relaxation;
 use ringmesh::mechanics::{ElementKind, StaticTermination};
 use ringmesh::run::{CantileverTable, FrameOutput, Progress};
 use ringmesh::scene::TrussModel;
@@ -55,6 +56,40 @@ enum Command {
         /// Output JSON file.
         #[arg(short, long)]
         output: PathBuf,
+    },
+    /// The main job: design the net for the truss as it deforms, prove it by
+    /// assembly, compare with the conventional (rigid-truss) design.
+    ///
+    /// The outer loop designs the net for a boundary, applies its pull to the
+    /// truss and repeats until the boundary the net is designed for is the one
+    /// the truss takes (‖G(C) − C‖∞ ≤ --tol). The design is then cut to length
+    /// and assembled on the undeformed flexible truss. Writes design.json,
+    /// cables.csv (with cut lengths), convergence.csv, convergence.png/.svg,
+    /// surface-error.png and model.vtu; one line per outer iteration on stderr.
+    ///
+    /// Example: ringmesh design problems/realistic-26m.toml --relaxation anderson,paper
+    Design {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// The uniformity solver.
+        #[arg(long, value_enum, default_value = "lp")]
+        solver: SolverKind,
+        /// The truss model [default: the scene's [effects] truss].
+        #[arg(long, value_enum)]
+        truss: Option<TrussModel>,
+        /// Relaxation policies, comma-separated: the first makes the design, the
+        /// others are run for the convergence comparison.
+        #[arg(long, value_enum, value_delimiter = ',', default_value = "anderson")]
+        relaxation: Vec<Relaxation>,
+        /// Stop when the boundary moves by at most this, m.
+        #[arg(long, default_value_t = 1e-6)]
+        tol: f64,
+        /// Most outer iterations.
+        #[arg(long, default_value_t = 50)]
+        max_iterations: usize,
+        /// Output folder [default: results/<scene name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
     /// One tension-uniformity design for the scene's theoretical (rigid) boundary.
     ///
@@ -203,6 +238,70 @@ fn main() -> ExitCode {
             say!("max residual: {:.3e} N", o.max_residual);
             say!("wrote {}", output.display());
         }),
+        Command::Design {
+            scene,
+            solver,
+            truss,
+            relaxation,
+            tol,
+            max_iterations,
+            output,
+        } => {
+            let options = ringmesh::run::DesignOptions {
+                solver: *solver,
+                truss: *truss,
+                relaxations: relaxation.clone(),
+                tolerance_m: *tol,
+                max_iterations: *max_iterations,
+            };
+            ringmesh::run::design(scene, &options, output.as_deref(), &mut |relaxation, r| {
+                eprintln!(
+                    "{:>8} {:>3}  boundary change {:.3e} m  ratio {:.6}  truss Newton {}  {:.2} s",
+                    relaxation.name(),
+                    r.iteration,
+                    r.boundary_change_max_m,
+                    r.ratio,
+                    r.oracle_newton_iterations,
+                    r.elapsed_s
+                );
+            })
+            .map(|outcome| {
+                let r = &outcome.report;
+                say!(
+                    "{}: {:?} after {} outer iterations, boundary residual {:.3e} m, ratio {:.6}",
+                    r.relaxation.name(),
+                    r.termination,
+                    r.outer_iterations,
+                    r.boundary_residual_m,
+                    r.ratio
+                );
+                let v = &r.verification;
+                say!(
+                    "assembled: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, boundary {:.3e} mm, {} slack cables",
+                    v.rms_mm,
+                    v.max_deviation_mm,
+                    v.max_tension_change_pct,
+                    v.boundary_deviation_mm,
+                    v.slack_cables.len()
+                );
+                if let Some(c) = &r.conventional {
+                    say!(
+                        "conventional (rigid-truss) design assembled: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, {} slack cables",
+                        c.rms_mm,
+                        c.max_deviation_mm,
+                        c.max_tension_change_pct,
+                        c.slack_cables.len()
+                    );
+                }
+                say!("time: {:.2} s", r.time_s);
+                for w in &r.net.warnings {
+                    say!("warning: {w}");
+                }
+                for path in &outcome.written {
+                    say!("wrote {}", path.display());
+                }
+            })
+        }
         Command::Optimize {
             scene,
             solver,

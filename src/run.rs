@@ -6,6 +6,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use crate::design::{
+    design_loop, IterationRecord, LoopSettings, LoopTermination, Relaxation, TiedNets,
+};
 use crate::fdm::solve_network;
 use crate::geometry::{build_mesh, ReflectorMesh};
 use crate::mechanics::cantilever::{self, CantileverRow};
@@ -14,13 +17,17 @@ use crate::mechanics::{
     StepRecord,
 };
 use crate::network::{norm3, Network, NetworkSummary};
-use crate::report::{cables_csv, front_csv, front_plot, network_vtu, write_atomic, write_json};
+use crate::report::{
+    assembly_vtu, cables_csv, convergence_plot, front_csv, front_plot, network_vtu, surface_plot,
+    write_atomic, write_json,
+};
 use crate::scene::{Scene, TrussModel};
 use crate::truss::SceneTrussResponse;
 use crate::uniformity::{
     design_front, Design, FrontPoint, SolverKind, SurfaceTarget, Termination, UniformityError,
     UniformityProblem, UniformitySet,
 };
+use crate::verify::{verify, AssemblyTruss, Verification};
 use crate::Error;
 
 /// Progress of a long command; the CLI attaches a progress bar, the library
@@ -526,4 +533,311 @@ pub fn truss(
     );
     write_json(&path, &response)?;
     Ok((response, path))
+}
+
+/// Choices of `ringmesh design`, resolved by the CLI.
+#[derive(Debug, Clone)]
+pub struct DesignOptions {
+    /// The uniformity solver.
+    pub solver: SolverKind,
+    /// The truss model (default: the scene's `[effects] truss`).
+    pub truss: Option<TrussModel>,
+    /// Relaxation policies: the first makes the design; the others only add
+    /// their convergence histories for comparison.
+    pub relaxations: Vec<Relaxation>,
+    /// Stopping tolerance on `‖G(C) − C‖∞`, m.
+    pub tolerance_m: f64,
+    /// Most outer iterations.
+    pub max_iterations: usize,
+}
+
+impl Default for DesignOptions {
+    fn default() -> Self {
+        let loop_settings = LoopSettings::default();
+        DesignOptions {
+            solver: SolverKind::Lp,
+            truss: None,
+            relaxations: vec![loop_settings.relaxation],
+            tolerance_m: loop_settings.tolerance_m,
+            max_iterations: loop_settings.max_iterations,
+        }
+    }
+}
+
+/// One relaxation policy's run of the outer loop.
+#[derive(Debug, Clone, Serialize)]
+pub struct LoopRun {
+    /// The policy.
+    pub relaxation: Relaxation,
+    /// How it ended.
+    pub termination: LoopTermination,
+    /// Outer iterations (designs made).
+    pub outer_iterations: usize,
+    /// Final `‖G(C) − C‖∞`, m.
+    pub boundary_residual_m: f64,
+    /// Wall time, s.
+    pub time_s: f64,
+    /// Per iteration.
+    pub history: Vec<IterationRecord>,
+    /// Why a comparison run stopped without a result (the truss found no
+    /// equilibrium once the iteration ran away, say).
+    pub error: Option<String>,
+}
+
+/// `design.json`: the outer loop's design, its verification by assembly, and
+/// the conventional (rigid-truss) design verified on the same truss.
+#[derive(Debug, Clone, Serialize)]
+pub struct DesignReport {
+    /// The scene's name.
+    pub scene: String,
+    /// The uniformity solver.
+    pub solver: String,
+    /// The truss model of the loop.
+    pub truss: TrussModel,
+    /// The relaxation policy that made the design.
+    pub relaxation: Relaxation,
+    /// How the loop ended.
+    pub termination: LoopTermination,
+    /// Outer iterations.
+    pub outer_iterations: usize,
+    /// Final fixed-point residual `‖G(C) − C‖∞`, m.
+    pub boundary_residual_m: f64,
+    /// The design's largest set ratio `Tmax/Tmin`.
+    pub ratio: f64,
+    /// Wall time of the whole run (every loop, verifications), s.
+    pub time_s: f64,
+    /// The design loop's iterations.
+    pub history: Vec<IterationRecord>,
+    /// Every policy run, the design's first.
+    pub runs: Vec<LoopRun>,
+    /// The design cut to length and assembled.
+    pub verification: Verification,
+    /// The rigid-truss design assembled on the same truss (absent when the
+    /// loop's truss is rigid: then it is the design itself).
+    pub conventional: Option<Verification>,
+    /// The boundary the design is made for, `C` (top hinges, then bottom), m.
+    pub boundary_m: Vec<[f64; 3]>,
+    /// The design: q, tensions, lengths, nodes, reactions, spreads.
+    pub net: Design,
+}
+
+/// What `ringmesh design` made.
+#[derive(Debug)]
+pub struct DesignOutcome {
+    /// The report (also in `design.json`).
+    pub report: DesignReport,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// `ringmesh design`: the outer design loop (net design ⇄ truss response) with
+/// each relaxation asked for, the design verified by assembly, the
+/// conventional design verified on the same truss, and every output written
+/// once all is computed. `observe` sees each outer iteration.
+pub fn design(
+    scene_path: &Path,
+    options: &DesignOptions,
+    output_dir: Option<&Path>,
+    observe: &mut dyn FnMut(Relaxation, &IterationRecord),
+) -> Result<DesignOutcome, Error> {
+    let clock = std::time::Instant::now();
+    let scene = Scene::read(scene_path)?;
+    let model = options.truss.unwrap_or(scene.effects.truss);
+    let (mesh, problem) = scene_problem(&scene)?;
+    let nets = TiedNets::new(&mesh, problem)?;
+    let solver = options.solver.build(None);
+    let relaxations = if options.relaxations.is_empty() {
+        vec![Relaxation::default()]
+    } else {
+        options.relaxations.clone()
+    };
+    let mut runs = Vec::new();
+    let mut outcome = None;
+    for &relaxation in &relaxations {
+        let settings = LoopSettings {
+            relaxation,
+            tolerance_m: options.tolerance_m,
+            max_iterations: options.max_iterations,
+            ..LoopSettings::default()
+        };
+        let mut oracle = crate::truss::oracle(model, &scene, &mesh.truss)?;
+        let mut history = Vec::new();
+        let result = design_loop(
+            &nets,
+            solver.as_ref(),
+            oracle.as_mut(),
+            &settings,
+            &mut |r| {
+                history.push(r.clone());
+                observe(relaxation, r)
+            },
+        );
+        match result {
+            Ok(result) => {
+                runs.push(LoopRun {
+                    relaxation,
+                    termination: result.termination,
+                    outer_iterations: result.history.len(),
+                    boundary_residual_m: result.boundary_residual_m(),
+                    time_s: result.time_s,
+                    history: result.history.clone(),
+                    error: None,
+                });
+                outcome.get_or_insert(result);
+            }
+            // A comparison run may fail without losing the design.
+            Err(e) if outcome.is_some() => runs.push(LoopRun {
+                relaxation,
+                termination: LoopTermination::Diverged,
+                outer_iterations: history.len(),
+                boundary_residual_m: history.last().map_or(f64::NAN, |r| r.boundary_change_max_m),
+                time_s: history.last().map_or(0.0, |r| r.elapsed_s),
+                history,
+                error: Some(e.to_string()),
+            }),
+            Err(e) => return Err(e.into()),
+        }
+    }
+    let outcome = outcome.expect("at least one relaxation");
+    let assembly = if model == TrussModel::Rigid {
+        AssemblyTruss::Rigid
+    } else {
+        AssemblyTruss::Flexible
+    };
+    let network = outcome.problem.network();
+    let verification = verify(&scene, &mesh, network, &outcome.design, assembly)?;
+    let conventional = match assembly {
+        AssemblyTruss::Rigid => None,
+        AssemblyTruss::Flexible => {
+            let rigid = nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
+            Some(verify(
+                &scene,
+                &mesh,
+                rigid.problem.network(),
+                &rigid.design,
+                AssemblyTruss::Flexible,
+            )?)
+        }
+    };
+
+    let report = DesignReport {
+        scene: scene.name.clone(),
+        solver: solver.name().to_string(),
+        truss: model,
+        relaxation: relaxations[0],
+        termination: outcome.termination,
+        outer_iterations: outcome.history.len(),
+        boundary_residual_m: outcome.boundary_residual_m(),
+        ratio: outcome.design.ratio,
+        time_s: clock.elapsed().as_secs_f64(),
+        history: outcome.history.clone(),
+        runs,
+        verification,
+        conventional,
+        boundary_m: outcome.boundary_m.clone(),
+        net: outcome.design.clone(),
+    };
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let written = write_design(&dir, &scene, &mesh, network, &report)?;
+    Ok(DesignOutcome { report, written })
+}
+
+/// The files of `ringmesh design`, each written atomically.
+fn write_design(
+    dir: &Path,
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    network: &Network,
+    report: &DesignReport,
+) -> Result<Vec<PathBuf>, Error> {
+    let path = |name: &str| dir.join(name);
+    let series: Vec<(String, Vec<(usize, f64)>)> = report
+        .runs
+        .iter()
+        .map(|run| {
+            (
+                run.relaxation.name().to_string(),
+                run.history
+                    .iter()
+                    .map(|r| (r.iteration, r.boundary_change_max_m))
+                    .collect(),
+            )
+        })
+        .collect();
+    convergence_plot(
+        &series,
+        &format!("{}: outer design loop", scene.name),
+        &path("convergence.png"),
+        &path("convergence.svg"),
+    )?;
+    let fixed = network.fixed_mask();
+    let surface: Vec<(f64, f64, f64)> = (0..mesh.n_front_nodes)
+        .filter(|&i| !fixed[i])
+        .map(|i| {
+            let p = report.verification.nodes_xyz_m[i];
+            (p[0], p[1], 1e3 * mesh.paraboloid.axial_deviation(p))
+        })
+        .collect();
+    surface_plot(
+        &surface,
+        &format!(
+            "{}: assembled surface error (mm), RMS {:.2e} mm",
+            scene.name, report.verification.rms_mm
+        ),
+        &path("surface-error.png"),
+    )?;
+    write_atomic(
+        &path("model.vtu"),
+        assembly_vtu(network, &report.net.q, &report.verification).as_bytes(),
+    )?;
+    write_atomic(
+        &path("convergence.csv"),
+        convergence_csv(&report.runs).as_bytes(),
+    )?;
+    write_atomic(
+        &path("cables.csv"),
+        cables_csv(network, &report.net, &scene.cables).as_bytes(),
+    )?;
+    write_json(&path("design.json"), report)?;
+    Ok([
+        "design.json",
+        "cables.csv",
+        "convergence.csv",
+        "convergence.png",
+        "convergence.svg",
+        "surface-error.png",
+        "model.vtu",
+    ]
+    .iter()
+    .map(|n| path(n))
+    .collect())
+}
+
+/// `relaxation,iteration,…`: one row per outer iteration of every run.
+fn convergence_csv(runs: &[LoopRun]) -> String {
+    use std::fmt::Write;
+    let mut s = String::from(
+        "relaxation,iteration,boundary_change_max_m,boundary_change_rms_m,xi_change_m,ratio,\
+         relaxation_factor,oracle_newton_iterations,design_time_s,truss_time_s,elapsed_s\n",
+    );
+    for run in runs {
+        for r in &run.history {
+            let _ = writeln!(
+                s,
+                "{},{},{:e},{:e},{},{:.12e},{:e},{},{:e},{:e},{:e}",
+                run.relaxation.name(),
+                r.iteration,
+                r.boundary_change_max_m,
+                r.boundary_change_rms_m,
+                r.xi_change_m.map_or(String::new(), |v| format!("{v:e}")),
+                r.ratio,
+                r.relaxation_factor,
+                r.oracle_newton_iterations,
+                r.design_time_s,
+                r.truss_time_s,
+                r.elapsed_s
+            );
+        }
+    }
+    s
 }

@@ -163,7 +163,14 @@ pub enum LoopTermination {
     Converged,
     /// The iteration budget ran out first.
     MaxIterations,
+    /// The residual grew past [`DIVERGENCE_FACTOR`] × its first value: the
+    /// policy cannot converge on this problem.
+    Diverged,
 }
+
+/// A residual this many times the first iteration's ends the loop as
+/// [`LoopTermination::Diverged`].
+pub const DIVERGENCE_FACTOR: f64 = 100.0;
 
 /// The converged (or last) design of the outer loop.
 #[derive(Debug, Clone)]
@@ -252,6 +259,8 @@ pub fn design_loop(
         let rms = (distances.iter().map(|d| d * d).sum::<f64>() / distances.len() as f64).sqrt();
         let previous_xi = history.last().map(|r| r.boundary_change_max_m);
         let converged = xi <= settings.tolerance_m;
+        let first_xi = history.first().map_or(xi, |r| r.boundary_change_max_m);
+        let diverged = xi > DIVERGENCE_FACTOR * first_xi;
         let factor = match settings.relaxation {
             Relaxation::Paper => paper_step(xi, previous_xi),
             Relaxation::Aitken => {
@@ -276,7 +285,7 @@ pub fn design_loop(
         };
         observe(&record);
         history.push(record);
-        if converged || iteration + 1 == settings.max_iterations {
+        if converged || diverged || iteration + 1 == settings.max_iterations {
             return Ok(LoopOutcome {
                 design: tied.design,
                 problem: tied.problem,
@@ -285,6 +294,8 @@ pub fn design_loop(
                 history,
                 termination: if converged {
                     LoopTermination::Converged
+                } else if diverged {
+                    LoopTermination::Diverged
                 } else {
                     LoopTermination::MaxIterations
                 },

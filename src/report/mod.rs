@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 pub use csv::{cables_csv, front_csv};
-pub use plot::front_plot;
-pub use vtk::network_vtu;
+pub use plot::{convergence_plot, front_plot, surface_plot};
+pub use vtk::{assembly_vtu, network_vtu};
 
 /// Writing a result failed.
 #[derive(Debug, thiserror::Error)]

@@ -3,6 +3,7 @@
 use std::fmt::Write;
 
 use crate::network::Network;
+use crate::verify::Verification;
 
 /// The network as a `.vtu` document: points, one line cell per cable; point data
 /// `fixed` (0/1); cell data `q_n_per_m`, `group` (index into the network's
@@ -91,4 +92,28 @@ pub fn network_vtu(
     }
     s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     s
+}
+
+/// The assembled model as one `.vtu`: the net at its assembled positions (its
+/// cables carry `q_n_per_m` and the assembled `force_n`) and the deformed
+/// truss as line cells of group `truss` (q and force 0).
+pub fn assembly_vtu(network: &Network, q: &[f64], verification: &Verification) -> String {
+    let mut combined = network.clone();
+    combined.nodes = verification.nodes_xyz_m.clone();
+    combined.q = q.to_vec();
+    let mut groups: Vec<String> = (0..network.n_edges())
+        .map(|k| network.group_of(k).to_string())
+        .collect();
+    let mut forces = verification.tensions_n.clone();
+    for [a, b] in &verification.truss_segments_m {
+        let i = combined.nodes.len();
+        combined.nodes.extend([*a, *b]);
+        combined.edges.push([i, i + 1]);
+        combined.q.push(0.0);
+        groups.push("truss".into());
+        forces.push(0.0);
+    }
+    combined.groups = Some(groups);
+    combined.loads = None;
+    network_vtu(&combined, None, Some(&forces))
 }

@@ -109,7 +109,7 @@ pub trait TrussOracle: Send {
 }
 
 /// The reference attachment points of a layout: top hinges, then bottom hinges.
-pub(crate) fn layout_points(layout: &RingTrussLayout) -> Vec<[f64; 3]> {
+pub fn layout_points(layout: &RingTrussLayout) -> Vec<[f64; 3]> {
     layout
         .top_m
         .iter()
