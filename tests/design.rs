@@ -119,7 +119,12 @@ fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
         let solver = kind.build(None);
         let c0 = layout_points(&mesh.truss);
         let d0 = nets.design(solver.as_ref(), &c0).unwrap();
-        let pull: Vec<[f64; 3]> = d0.design.reactions_n.iter().map(|r| r.map(|v| -v)).collect();
+        let pull: Vec<[f64; 3]> = d0
+            .design
+            .reactions_n
+            .iter()
+            .map(|r| r.map(|v| -v))
+            .collect();
         let moved = truss.respond(&pull).unwrap().positions_m;
         let d = nets.design(solver.as_ref(), &moved).unwrap();
         let max_tension = d.design.max_tension_n;
@@ -128,7 +133,11 @@ fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
             "{kind:?}: residual {} N",
             d.design.max_residual_n
         );
-        assert!(d.design.surface_rms_m <= 1e-9, "{kind:?}: {}", d.design.surface_rms_m);
+        assert!(
+            d.design.surface_rms_m <= 1e-9,
+            "{kind:?}: {}",
+            d.design.surface_rms_m
+        );
         // The ratio moves with the boundary, continuously.
         assert!((d.design.ratio / d0.design.ratio - 1.0).abs() < 0.01);
     }
@@ -175,12 +184,9 @@ fn anderson_converges_where_the_paper_rule_cannot() {
     };
     let anderson = run(Relaxation::Anderson).unwrap();
     assert_eq!(anderson.termination, LoopTermination::Converged);
-    let paper = run(Relaxation::Paper);
-    match paper {
-        Ok(outcome) => {
-            assert_ne!(outcome.termination, LoopTermination::Converged);
-        }
-        Err(_) => {} // the truss gave up once the iteration ran away
+    // Either the loop reports it, or the truss gives up once it runs away.
+    if let Ok(paper) = run(Relaxation::Paper) {
+        assert_ne!(paper.termination, LoopTermination::Converged);
     }
     assert!(anderson.history.len() < 40);
 }

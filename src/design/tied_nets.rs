@@ -268,7 +268,7 @@ impl TiedNets {
         q[n..2 * n].copy_from_slice(&q_rear);
         for (t, &(k, i, r)) in self.ties.iter().enumerate() {
             let length = whole[i][2] - whole[r][2];
-            if !(length > 0.0) {
+            if length.is_nan() || length <= 0.0 {
                 return Err(invalid(format!(
                     "tie {k}: the rear node {r} rises to {:.4} m, above front node {i} at \
                      {:.4} m — the rear net is too slack for this boundary",
@@ -384,7 +384,9 @@ impl TiedNets {
                 *qk -= q0[k] * q0[k] * at_mu;
             }
         }
-        let negative: Vec<usize> = (0..q.len()).filter(|&k| !(q[k] > 0.0)).collect();
+        let negative: Vec<usize> = (0..q.len())
+            .filter(|&k| q[k].is_nan() || q[k] <= 0.0)
+            .collect();
         if !negative.is_empty() {
             return Err(invalid(format!(
                 "rear-net cables {:?} cannot stay in tension with the deformed bottom hinges",

@@ -198,7 +198,7 @@ impl UniformityProblem {
             .into_iter()
             .map(norm3)
             .collect();
-        if let Some(k) = moved.lengths_m.iter().position(|&l| !(l > 0.0)) {
+        if let Some(k) = moved.lengths_m.iter().position(|&l| l.is_nan() || l <= 0.0) {
             return Err(UniformityError::Invalid(format!(
                 "cable {k} (nodes {:?}) has zero length in the prescribed geometry",
                 moved.network.edges[k]
