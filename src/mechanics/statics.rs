@@ -187,8 +187,15 @@ pub struct StaticSolver {
 const CONTRACTION: f64 = 0.5;
 
 /// Corrections below this fraction of the predictor are not tested for
-/// contraction: too small to change branch, and near roundoff at the end.
-const CONTRACTION_FLOOR: f64 = 1e-6;
+/// contraction. A correction that changes branch moves Newton by about the
+/// distance between the branches, as large as the predictor or larger (a von
+/// Mises truss past its limit: 0.76–0.95 of it in the first correction),
+/// while Newton on a stable but strongly nonlinear path wanders by a few per
+/// cent (a cantilever rolled up by a quarter turn per step: 9 %, after which
+/// it converges quadratically). Measured: 0.2 lets a truss at 30 × its limit
+/// load snap through, 0.1 stops every overload from 1.01 × to 30 ×, and the
+/// full-circle cantilever needs 4 steps with it, 13 with 0.01.
+const CONTRACTION_FLOOR: f64 = 0.1;
 
 /// Largest ratio of a step's tangent predictor per unit load to the previous
 /// step's increment per unit load. Next to a fold the tangent is nearly
