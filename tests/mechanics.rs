@@ -842,11 +842,12 @@ fn load_control_does_not_report_a_snapped_through_truss_as_converged() {
 #[test]
 fn load_control_stops_at_the_von_mises_limit_point() {
     // Beyond the limit load the loading branch ends: every step past
-    // λ* = P_lim/P is cut (Newton meets negative stiffness on its way to the
-    // inverted branch) until it is shorter than min_step, so the solve ends
-    // as a limit point whose load factor is within the stall resolution of
-    // λ*: the first failing step was shorter than 4·min_step. The apex stays
-    // on the loading branch, above the limit height.
+    // λ* = P_lim/P is cut (Newton bounces through the unstable states towards
+    // the inverted branch instead of contracting onto the predicted point)
+    // until it is shorter than min_step, so the solve ends as a limit point
+    // whose load factor is within the stall resolution of λ*: the first
+    // failing step was shorter than 4·min_step. The apex stays on the loading
+    // branch, above the limit height.
     let (p_lim, y_lim) = von_mises_limit();
     let settings = StaticSettings::default();
     for factor in [1.2, 1.5, 3.0] {
