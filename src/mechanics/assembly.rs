@@ -31,10 +31,10 @@ const FIXED: usize = usize::MAX;
 /// few microseconds, a parallel fork-join about as much as ten of them.
 const PARALLEL_ELEMENTS: usize = 64;
 
-/// Unknowns up to which the tangent is factored dense: a dense LU of a few
-/// dozen rows (a cantilever of 10 elements: 60) takes a fraction of the
-/// per-column overhead of the sparse one.
-const DENSE_ROWS: usize = 96;
+/// Unknowns up to which the tangent is factored dense: at a cantilever of 10
+/// elements (60 unknowns) the dense LU takes a fraction of the per-column
+/// overhead of the sparse one; at 96 unknowns they cost the same.
+const DENSE_ROWS: usize = 64;
 
 /// A factorisation of the tangent: dense for small systems, sparse otherwise.
 pub(crate) enum Factor {
