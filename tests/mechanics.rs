@@ -959,3 +959,18 @@ fn bad_frames_are_refused_naming_the_item() {
     assert_eq!(item, "joint 1");
     assert!(reason.contains("itself"), "{reason}");
 }
+
+#[test]
+fn an_unsupported_rod_is_refused_as_a_mechanism() {
+    // Six rigid-body modes and no support: the tangent is singular, and the
+    // small-displacement solve says so instead of returning roundoff-sized
+    // pivots' garbage (small systems are factored dense).
+    let mut b = ModelBuilder::new();
+    let rod = b.add_rod(Vector3::zeros(), Vector3::x(), Vector3::y(), &spec(3));
+    b.add_load(rod.end(), Vector3::y(), Vector3::zeros());
+    let solver = StaticSolver::new(b.build().unwrap()).unwrap();
+    match solver.linear_response() {
+        Err(MechanicsError::Mechanism { detail }) => eprintln!("mechanism: {detail}"),
+        other => panic!("expected a mechanism, got {:?}", other.map(|s| s.frames[3])),
+    }
+}

@@ -274,15 +274,28 @@ impl System {
         }
     }
 
-    /// Factor the tangent with `values` (pattern order). A singular dense
-    /// factor shows as non-finite solutions.
+    /// Factor the tangent with `values` (pattern order).
+    ///
+    /// # Errors
+    /// A singular tangent: for the dense factor, a pivot below `n ε ‖J‖max`,
+    /// the roundoff of a zero pivot (a mechanism).
     pub fn factor(&self, values: &[f64]) -> Result<Factor, String> {
         if self.n_rows <= DENSE_ROWS {
             let mut dense = Mat::<f64>::zeros(self.n_rows, self.n_rows);
             for (p, v) in self.pattern.iter().zip(values) {
                 dense[(p.row, p.col)] += v;
             }
-            return Ok(Factor::Dense(dense.partial_piv_lu()));
+            let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let lu = dense.partial_piv_lu();
+            let roundoff = self.n_rows as f64 * f64::EPSILON * largest;
+            let u = lu.U();
+            if let Some(i) = (0..self.n_rows).find(|&i| !(u[(i, i)].abs() > roundoff)) {
+                return Err(format!(
+                    "singular tangent: pivot {i} is {:e}, below the roundoff {roundoff:e}",
+                    u[(i, i)]
+                ));
+            }
+            return Ok(Factor::Dense(lu));
         }
         let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
             .map_err(|e| format!("{e:?}"))?;
