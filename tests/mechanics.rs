@@ -2,7 +2,8 @@
 //! cantilever rolled up by a tip moment (paper §3.4, Tables 1–2) and the
 //! Crisfield–Jelenić element's own discrete solution, joints that transmit
 //! what they should, Newton's quadratic convergence, arc length through the
-//! limit point of a von Mises truss, and named errors for bad frames.
+//! limit point of a von Mises truss and load control stopping at it (never
+//! converging on the snapped-through branch), and named errors for bad frames.
 
 use std::f64::consts::{PI, TAU};
 
@@ -828,29 +829,93 @@ fn arc_length_passes_the_von_mises_limit_point() {
 }
 
 #[test]
-fn load_control_stalls_at_the_von_mises_limit_point() {
-    // At 1.2 P_lim the last converged load factor is within the stall
-    // resolution of the limit: steps are cut ÷4 until below min_step, so the
-    // first failing step was shorter than 4·min_step.
+fn load_control_does_not_report_a_snapped_through_truss_as_converged() {
     let (p_lim, y_lim) = von_mises_limit();
-    let applied = 1.2 * p_lim;
-    let (solver, apex) = von_mises(applied);
+    for factor in [1.2, 1.5, 3.0] {
+        let (solver, apex) = von_mises(factor * p_lim);
+        let solution = solver.solve(&StaticSettings::default()).unwrap();
+        let y = solution.state.frames[apex].position_m.y;
+        assert!(!solution.converged(), "{factor} P_lim: {:?} with the apex at y = {y:.4} (limit at y = {y_lim:.4}, supports at 0)", solution.termination);
+    }
+}
+
+#[test]
+fn load_control_stops_at_the_von_mises_limit_point() {
+    // Beyond the limit load the loading branch ends: every step past
+    // λ* = P_lim/P is cut (Newton bounces through the unstable states towards
+    // the inverted branch instead of contracting onto the predicted point)
+    // until it is shorter than min_step, so the solve ends as a limit point
+    // whose load factor is within the stall resolution of λ*: the first
+    // failing step was shorter than 4·min_step. The apex stays on the loading
+    // branch, above the limit height.
+    let (p_lim, y_lim) = von_mises_limit();
     let settings = StaticSettings::default();
-    let solution = solver.solve(&settings).unwrap();
-    let StaticTermination::Stalled { load_factor } = solution.termination else {
-        panic!("expected a stall, got {:?}", solution.termination);
-    };
-    let exact = p_lim / applied;
-    assert!(load_factor <= exact * (1.0 + 1e-9));
+    for factor in [1.2, 1.5, 3.0] {
+        let applied = factor * p_lim;
+        let (solver, apex) = von_mises(applied);
+        let solution = solver.solve(&settings).unwrap();
+        let StaticTermination::LimitPoint { limit_load_factor } = solution.termination else {
+            panic!(
+                "{factor} P_lim: expected a limit point, got {:?}",
+                solution.termination
+            );
+        };
+        assert_eq!(limit_load_factor, solution.load_factor);
+        let exact = p_lim / applied;
+        assert!(limit_load_factor <= exact * (1.0 + 1e-9));
+        assert!(
+            exact - limit_load_factor <= 4.0 * settings.min_step,
+            "{factor} P_lim: stopped at {limit_load_factor}, limit {exact}"
+        );
+        let x = solution.state.frames[apex].position_m;
+        assert!(
+            x.y > y_lim,
+            "{factor} P_lim: the apex passed the limit height: {} < {y_lim}",
+            x.y
+        );
+        // The last converged state is an equilibrium of the loading branch.
+        let on_path = (von_mises_load(x.y) - solution.load_factor * applied).abs() / p_lim;
+        assert!(
+            on_path <= 1e-8,
+            "{factor} P_lim: off the path by {on_path:e} P_lim"
+        );
+        eprintln!(
+            "load control at {factor} P_lim: limit point at λ {limit_load_factor:.8} vs {exact:.8} (gap {:.1e}), apex y {:.5} (limit {y_lim:.5}), {} steps, {} cut, {} Newton iterations",
+            exact - limit_load_factor,
+            x.y,
+            solution.steps.len(),
+            solution.rejected_steps,
+            solution.newton_iterations
+        );
+    }
+}
+
+#[test]
+fn load_control_converges_on_the_stable_branch_below_the_limit_load() {
+    // At 0.8 P_lim the loading branch carries the full load: converged, the
+    // apex above the limit height, on the analytic path P(y) = 0.8 P_lim.
+    let (p_lim, y_lim) = von_mises_limit();
+    let applied = 0.8 * p_lim;
+    let (solver, apex) = von_mises(applied);
+    let solution = solver.solve(&StaticSettings::default()).unwrap();
+    assert_eq!(solution.termination, StaticTermination::Converged);
+    let x = solution.state.frames[apex].position_m;
     assert!(
-        exact - load_factor <= 4.0 * settings.min_step,
-        "stalled at {load_factor}, limit {exact}"
+        x.y > y_lim && x.y < VM_RISE_M,
+        "apex at y = {} (limit {y_lim})",
+        x.y
     );
-    let y = solution.state.frames[apex].position_m.y;
-    assert!(y > y_lim, "the apex passed the limit height: {y} < {y_lim}");
+    let on_path = (von_mises_load(x.y) - applied).abs() / p_lim;
+    assert!(on_path <= 1e-8, "off the path by {on_path:e} P_lim");
+    assert!(
+        x.x.abs() <= 1e-9 && x.z.abs() <= 1e-9,
+        "apex off the plane of symmetry: {x:?}"
+    );
     eprintln!(
-        "load control stalls at λ {load_factor:.8} vs {exact:.8} (gap {:e})",
-        exact - load_factor
+        "0.8 P_lim: apex y {:.5} (limit {y_lim:.5}), {} steps, {} cut",
+        x.y,
+        solution.steps.len(),
+        solution.rejected_steps
     );
 }
 
@@ -893,4 +958,19 @@ fn bad_frames_are_refused_naming_the_item() {
     let (item, reason) = invalid_item(b.build());
     assert_eq!(item, "joint 1");
     assert!(reason.contains("itself"), "{reason}");
+}
+
+#[test]
+fn an_unsupported_rod_is_refused_as_a_mechanism() {
+    // Six rigid-body modes and no support: the tangent is singular, and the
+    // small-displacement solve says so instead of returning roundoff-sized
+    // pivots' garbage (small systems are factored dense).
+    let mut b = ModelBuilder::new();
+    let rod = b.add_rod(Vector3::zeros(), Vector3::x(), Vector3::y(), &spec(3));
+    b.add_load(rod.end(), Vector3::y(), Vector3::zeros());
+    let solver = StaticSolver::new(b.build().unwrap()).unwrap();
+    match solver.linear_response() {
+        Err(MechanicsError::Mechanism { detail }) => eprintln!("mechanism: {detail}"),
+        other => panic!("expected a mechanism, got {:?}", other.map(|s| s.frames[3])),
+    }
 }

@@ -33,7 +33,7 @@ fn reference_load(solver: &StaticSolver, system: &System) -> Vec<f64> {
 }
 
 /// Weights of the arc-length norm: 1 on translations, `ℓ` on rotations, 0 on multipliers.
-fn weights(solver: &StaticSolver, system: &System) -> Vec<f64> {
+pub(crate) fn weights(solver: &StaticSolver, system: &System) -> Vec<f64> {
     let model = solver.model();
     let mean_length = if model.elements.is_empty() {
         solver.length_scale()
@@ -51,7 +51,7 @@ fn weights(solver: &StaticSolver, system: &System) -> Vec<f64> {
     w
 }
 
-fn wdot(w: &[f64], a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn wdot(w: &[f64], a: &[f64], b: &[f64]) -> f64 {
     w.iter()
         .zip(a)
         .zip(b)

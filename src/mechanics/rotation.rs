@@ -107,6 +107,7 @@ pub(crate) fn dot<S: DualNum<f64> + Copy>(a: &V3<S>, b: &V3<S>) -> S {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+#[cfg(test)]
 pub(crate) fn sub<S: DualNum<f64> + Copy>(a: &V3<S>, b: &V3<S>) -> V3<S> {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -121,11 +122,13 @@ pub(crate) fn mat_vec<S: DualNum<f64> + Copy>(a: &M3<S>, b: &V3<S>) -> V3<S> {
 }
 
 /// `Aᵀ b`.
+#[cfg(test)]
 pub(crate) fn mat_t_vec<S: DualNum<f64> + Copy>(a: &M3<S>, b: &V3<S>) -> V3<S> {
     std::array::from_fn(|j| a[0][j] * b[0] + a[1][j] * b[1] + a[2][j] * b[2])
 }
 
 /// `A B`.
+#[cfg(test)]
 pub(crate) fn mat_mat<S: DualNum<f64> + Copy>(a: &M3<S>, b: &M3<S>) -> M3<S> {
     std::array::from_fn(|i| {
         std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
@@ -133,6 +136,7 @@ pub(crate) fn mat_mat<S: DualNum<f64> + Copy>(a: &M3<S>, b: &M3<S>) -> M3<S> {
 }
 
 /// `Aᵀ B`.
+#[cfg(test)]
 pub(crate) fn mat_t_mat<S: DualNum<f64> + Copy>(a: &M3<S>, b: &M3<S>) -> M3<S> {
     std::array::from_fn(|i| {
         std::array::from_fn(|j| a[0][i] * b[0][j] + a[1][i] * b[1][j] + a[2][i] * b[2][j])
