@@ -314,7 +314,7 @@ impl StaticSolver {
         lambda: f64,
         settings: &StaticSettings,
         w: &[f64],
-        max_predictor: f64,
+        max_predictor: Option<f64>,
     ) -> NewtonRun {
         let n_free = self.system.n_free;
         let mut run = NewtonRun {
@@ -368,6 +368,11 @@ impl StaticSolver {
                 run.negative_curvature = true;
             }
             let size = wdot(w, &delta, &delta).sqrt();
+            let Some(max_predictor) = max_predictor else {
+                // No branch tests: the step is not driven by dead loads.
+                self.system.apply(state, &delta, 1.0);
+                continue;
+            };
             if it == 0 {
                 predictor = size;
                 if predictor > max_predictor {
@@ -509,6 +514,9 @@ impl StaticSolver {
         let mut reactions = vec![[0.0; 6]; self.model.node_count()];
         // The path's slope over the last accepted step (none yet: no bound).
         let mut previous_slope = f64::INFINITY;
+        // The branch tests follow the path of dead loads; a structure loaded
+        // only by its prestrain (an assembled cable net) has no such path.
+        let dead_loads = self.load_scale() > 0.0;
         let termination = loop {
             if lambda >= 1.0 {
                 break StaticTermination::Converged;
@@ -526,13 +534,15 @@ impl StaticSolver {
                 target,
                 settings,
                 &w,
-                BRANCH_RATIO * previous_slope * d_lambda,
+                dead_loads.then_some(BRANCH_RATIO * previous_slope * d_lambda),
             );
             newton_iterations += run.iterations;
             let verdict = match run.end {
                 NewtonEnd::Converged => Ok(run.secant / d_lambda),
                 NewtonEnd::Overshoot | NewtonEnd::Expanding => Err(Rejection::OffBranch),
-                NewtonEnd::Failed if run.negative_curvature => Err(Rejection::OffBranch),
+                NewtonEnd::Failed if run.negative_curvature && dead_loads => {
+                    Err(Rejection::OffBranch)
+                }
                 NewtonEnd::Failed => Err(Rejection::NotConverged),
             };
             match verdict {
