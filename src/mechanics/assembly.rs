@@ -351,7 +351,11 @@ impl System {
             let lu = dense.partial_piv_lu();
             let roundoff = self.n_rows as f64 * f64::EPSILON * largest;
             let u = lu.U();
-            if let Some(i) = (0..self.n_rows).find(|&i| !(u[(i, i)].abs() > roundoff)) {
+            let singular = |i: &usize| {
+                let pivot = u[(*i, *i)].abs();
+                pivot.is_nan() || pivot <= roundoff
+            };
+            if let Some(i) = (0..self.n_rows).find(singular) {
                 return Err(format!(
                     "singular tangent: pivot {i} is {:e}, below the roundoff {roundoff:e}",
                     u[(i, i)]
