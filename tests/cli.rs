@@ -103,8 +103,8 @@ fn bad_scene_fails_with_exit_2_and_writes_nothing() {
     std::fs::write(
         &scene,
         text.replace(
-            "tube_inner_diameter_m = 0.022",
-            "tube_inner_diameter_m = 0.03",
+            "tube_inner_diameter_m = 0.056",
+            "tube_inner_diameter_m = 0.07",
         ),
     )
     .unwrap();

@@ -80,9 +80,8 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
         conventional.rms_mm,
         designed.rms_mm
     );
-    // The truss moves the hinges by ~1 mm, ten times the cables' elastic
-    // stretch: the conventional net loses tension somewhere.
-    assert!(conventional.boundary_deviation_mm > 0.5);
+    // The conventional design's boundary is off by the truss's deflection.
+    assert!(conventional.boundary_deviation_mm >= 100.0 * designed.boundary_deviation_mm);
 }
 
 /// When the physics agree — a design on a rigid truss, assembled on a rigid
@@ -164,29 +163,33 @@ fn rigid_truss_loop_stops_after_one_design() {
     }
 }
 
-/// Anderson mixing needs fewer outer iterations than the paper's rule — here
-/// the paper's rule does not converge at all: the pull of a net redesigned on
-/// a moved boundary pushes the truss further in one mode (gain > 1), which
-/// neither full nor half steps can damp.
+/// Every relaxation policy converges on a truss that carries its net with a
+/// margin, and Anderson mixing needs the fewest outer iterations.
 #[test]
-fn anderson_converges_where_the_paper_rule_cannot() {
+fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
     let (scene, mesh, nets) = small_hex();
-    let solver = SolverKind::LeastSquares.build(None);
-    let run = |relaxation| {
-        let mut truss = oracle(TrussModel::Linear, &scene, &mesh.truss).unwrap();
-        design_loop(
+    let solver = SolverKind::Lp.build(None);
+    let iterations = |relaxation| {
+        let mut truss = oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+        let outcome = design_loop(
             &nets,
             solver.as_ref(),
             truss.as_mut(),
             &settings(relaxation),
             &mut |_| {},
         )
+        .unwrap();
+        assert_eq!(
+            outcome.termination,
+            LoopTermination::Converged,
+            "{relaxation:?}"
+        );
+        assert!(outcome.boundary_residual_m() <= 1e-7);
+        outcome.history.len()
     };
-    let anderson = run(Relaxation::Anderson).unwrap();
-    assert_eq!(anderson.termination, LoopTermination::Converged);
-    // Either the loop reports it, or the truss gives up once it runs away.
-    if let Ok(paper) = run(Relaxation::Paper) {
-        assert_ne!(paper.termination, LoopTermination::Converged);
-    }
-    assert!(anderson.history.len() < 40);
+    let anderson = iterations(Relaxation::Anderson);
+    let paper = iterations(Relaxation::Paper);
+    let aitken = iterations(Relaxation::Aitken);
+    assert!(anderson < paper, "Anderson {anderson}, paper {paper}");
+    assert!(anderson <= aitken, "Anderson {anderson}, Aitken {aitken}");
 }

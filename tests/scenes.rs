@@ -146,17 +146,17 @@ const BAD: &[(&str, &str, &str)] = &[
     ("height_m", "0.0", "truss.height_m"),
     (
         "tube_outer_diameter_m",
-        "-0.024",
+        "-0.060",
         "truss.tube_outer_diameter_m",
     ),
     (
         "tube_inner_diameter_m",
-        "0.024",
+        "0.060",
         "truss.tube_inner_diameter_m",
     ),
     (
         "tube_inner_diameter_m",
-        "0.030",
+        "0.070",
         "truss.tube_inner_diameter_m",
     ),
     ("youngs_modulus_pa", "0.0", "truss.youngs_modulus_pa"),
