@@ -190,11 +190,6 @@ impl TiedNets {
         })
     }
 
-    /// The whole network's problem on the theoretical boundary.
-    pub fn problem(&self) -> &UniformityProblem {
-        &self.full
-    }
-
     /// The two-stage design for attachment points `boundary_m` (top hinges,
     /// then bottom hinges: the order of the network's fixed nodes).
     ///

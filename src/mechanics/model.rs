@@ -170,16 +170,13 @@ fn check_load(i: usize, l: &NodalLoad, node_dofs: &[usize]) -> Result<(), Mechan
     Ok(())
 }
 
-fn check_cable(k: usize, c: &Cable, reference: &[Frame]) -> Result<(), MechanicsError> {
-    let item = format!("cable {k}");
-    let [a, b] = c.nodes;
-    for n in [a, b] {
-        if n >= reference.len() {
-            return Err(MechanicsError::invalid(
-                item,
-                format!("node {n} does not exist"),
-            ));
-        }
+/// The two ends of a joint or cable: existing, distinct nodes.
+fn check_ends(item: &str, [a, b]: [NodeId; 2], n_nodes: usize) -> Result<(), MechanicsError> {
+    if let Some(n) = [a, b].into_iter().find(|&n| n >= n_nodes) {
+        return Err(MechanicsError::invalid(
+            item,
+            format!("node {n} does not exist"),
+        ));
     }
     if a == b {
         return Err(MechanicsError::invalid(
@@ -187,6 +184,13 @@ fn check_cable(k: usize, c: &Cable, reference: &[Frame]) -> Result<(), Mechanics
             format!("joins node {a} to itself"),
         ));
     }
+    Ok(())
+}
+
+fn check_cable(k: usize, c: &Cable, reference: &[Frame]) -> Result<(), MechanicsError> {
+    let item = format!("cable {k}");
+    let [a, b] = c.nodes;
+    check_ends(&item, [a, b], reference.len())?;
     if (reference[a].position_m - reference[b].position_m).norm() == 0.0 {
         return Err(MechanicsError::invalid(
             item,
@@ -400,20 +404,7 @@ impl ModelBuilder {
         let mut joints = Vec::with_capacity(self.joints.len());
         for (j, &(kind, a, b, at)) in self.joints.iter().enumerate() {
             let item = format!("joint {j}");
-            for n in [a, b] {
-                if n >= self.reference.len() {
-                    return Err(MechanicsError::invalid(
-                        item,
-                        format!("node {n} does not exist"),
-                    ));
-                }
-            }
-            if a == b {
-                return Err(MechanicsError::invalid(
-                    item,
-                    format!("joins node {a} to itself"),
-                ));
-            }
+            check_ends(&item, [a, b], self.reference.len())?;
             if !at.iter().all(|v| v.is_finite()) {
                 return Err(MechanicsError::invalid(item, "its point is not finite"));
             }

@@ -9,7 +9,9 @@ use std::time::Instant;
 
 use nalgebra::Vector3;
 
-use super::{check_loads, layout_points, RingTruss, TrussError, TrussOracle, TrussResponse};
+use super::{
+    layout_points, set_attachment_loads, RingTruss, TrussError, TrussOracle, TrussResponse,
+};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::{NodalLoad, NodeId, State, StaticSettings, StaticSolver};
 
@@ -80,11 +82,8 @@ impl TrussOracle for ExactTruss {
     }
 
     fn respond(&mut self, loads_n: &[[f64; 3]]) -> Result<TrussResponse, TrussError> {
-        check_loads(loads_n, self.points.len())?;
         let clock = Instant::now();
-        self.solver
-            .model_mut()
-            .set_loads(nodal_loads(&self.attachments, loads_n))?;
+        set_attachment_loads(&mut self.solver, &self.attachments, loads_n)?;
         let mut iterations = 0;
         let mut solution = None;
         if let Some(previous) = self.previous.take() {

@@ -3,7 +3,9 @@
 
 use std::time::Instant;
 
-use super::{check_loads, layout_points, RingTruss, TrussError, TrussOracle, TrussResponse};
+use super::{
+    layout_points, set_attachment_loads, RingTruss, TrussError, TrussOracle, TrussResponse,
+};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::StaticSolver;
 
@@ -38,11 +40,8 @@ impl TrussOracle for LinearTruss {
     }
 
     fn respond(&mut self, loads_n: &[[f64; 3]]) -> Result<TrussResponse, TrussError> {
-        check_loads(loads_n, self.points.len())?;
         let clock = Instant::now();
-        self.solver
-            .model_mut()
-            .set_loads(super::exact::nodal_loads(&self.attachments, loads_n))?;
+        set_attachment_loads(&mut self.solver, &self.attachments, loads_n)?;
         let state = self.solver.linear_response()?;
         Ok(TrussResponse {
             positions_m: super::exact::positions(&state, &self.attachments),

@@ -135,6 +135,20 @@ pub(crate) fn check_loads(loads_n: &[[f64; 3]], expected: usize) -> Result<(), T
     }
 }
 
+/// Check `loads_n` against the attachment points and set them as the dead
+/// loads of `solver`'s frame (forces at the hinge bodies `attachments`).
+pub(crate) fn set_attachment_loads(
+    solver: &mut crate::mechanics::StaticSolver,
+    attachments: &[crate::mechanics::NodeId],
+    loads_n: &[[f64; 3]],
+) -> Result<(), TrussError> {
+    check_loads(loads_n, attachments.len())?;
+    solver
+        .model_mut()
+        .set_loads(exact::nodal_loads(attachments, loads_n))?;
+    Ok(())
+}
+
 /// The oracle a scene asks for (`[effects] truss`): only that model is built —
 /// a rigid scene never constructs a beam model.
 ///

@@ -144,30 +144,6 @@ impl UniformityProblem {
         )
     }
 
-    /// The same problem with the fixed nodes moved to `positions_m` (one per
-    /// entry of the network's `fixed`, in that order): the boundary `C_k` of an
-    /// outer design iteration (paper §4). The free nodes keep their prescribed
-    /// positions; the factorisation structure is reused.
-    ///
-    /// # Errors
-    /// A count that does not match, a non-finite position, or a cable that
-    /// the move makes zero-length (named).
-    pub fn with_boundary(&self, positions_m: &[[f64; 3]]) -> Result<Self, UniformityError> {
-        let fixed = &self.network.fixed;
-        if positions_m.len() != fixed.len() {
-            return Err(UniformityError::Invalid(format!(
-                "boundary: {} positions for {} fixed nodes",
-                positions_m.len(),
-                fixed.len()
-            )));
-        }
-        let mut nodes = self.network.nodes.clone();
-        for (&i, p) in fixed.iter().zip(positions_m) {
-            nodes[i] = *p;
-        }
-        self.with_positions(nodes)
-    }
-
     /// The same problem on new prescribed positions of every node (n_nodes × 3);
     /// the factorisation structure is reused.
     ///
