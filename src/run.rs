@@ -13,8 +13,8 @@ use crate::fdm::solve_network;
 use crate::geometry::{build_mesh, ReflectorMesh};
 use crate::mechanics::cantilever::{self, CantileverRow};
 use crate::mechanics::{
-    rotation, ElementKind, FrameFile, FrameFileError, NodeOrigin, StaticSolver, StaticTermination,
-    StepRecord,
+    rotation, ElementKind, FrameFile, FrameFileError, LimitSearch, NodeOrigin, StaticSolver,
+    StaticTermination, StepRecord,
 };
 use crate::network::{norm3, Network, NetworkSummary};
 use crate::report::{
@@ -22,7 +22,7 @@ use crate::report::{
     write_atomic, write_json,
 };
 use crate::scene::{Scene, TrussModel};
-use crate::truss::SceneTrussResponse;
+use crate::truss::{RingTruss, SceneTrussResponse, TrussError};
 use crate::uniformity::{
     design_front, Design, FrontPoint, SolverKind, SurfaceTarget, Termination, UniformityError,
     UniformityProblem, UniformitySet,
@@ -615,6 +615,9 @@ pub struct DesignReport {
     /// The rigid-truss design assembled on the same truss (absent when the
     /// loop's truss is rigid: then it is the design itself).
     pub conventional: Option<Verification>,
+    /// The flexible truss's limit load under the design's pull (DESIGN §9):
+    /// stable up to `stable_to` × the pull (absent for a rigid truss).
+    pub limit_margin: Option<LimitSearch>,
     /// The boundary the design is made for, `C` (top hinges, then bottom), m.
     pub boundary_m: Vec<[f64; 3]>,
     /// The design: q, tensions, lengths, nodes, reactions, spreads.
@@ -704,6 +707,10 @@ pub fn design(
     } else {
         AssemblyTruss::Flexible
     };
+    let limit_margin = match assembly {
+        AssemblyTruss::Rigid => None,
+        AssemblyTruss::Flexible => Some(design_margin(&scene, &mesh, &outcome.design)?),
+    };
     let network = outcome.problem.network();
     let verification = verify(&scene, &mesh, network, &outcome.design, assembly)?;
     let conventional = match assembly {
@@ -734,12 +741,36 @@ pub fn design(
         runs,
         verification,
         conventional,
+        limit_margin,
         boundary_m: outcome.boundary_m.clone(),
         net: outcome.design.clone(),
     };
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     let written = write_design(&dir, &scene, &mesh, network, &report)?;
     Ok(DesignOutcome { report, written })
+}
+
+/// The margin of `scene`'s truss to its limit load under `design`'s pull.
+///
+/// # Errors
+/// A pull the truss cannot carry stably ([`TrussError::PastLimitLoad`]).
+fn design_margin(
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    design: &Design,
+) -> Result<LimitSearch, Error> {
+    // The net pulls on its supports with −F_g.
+    let pull: Vec<[f64; 3]> = design.reactions_n.iter().map(|r| r.map(|v| -v)).collect();
+    let truss = RingTruss::new(scene, &mesh.truss).map_err(TrussError::from)?;
+    let margin = crate::truss::limit_margin(truss, &pull)?;
+    match margin.unstable_from {
+        Some(unstable_from) if margin.stable_to < 1.0 => Err(TrussError::PastLimitLoad {
+            stable_to: margin.stable_to,
+            unstable_from,
+        }
+        .into()),
+        _ => Ok(margin),
+    }
 }
 
 /// The files of `ringmesh design`, each written atomically.

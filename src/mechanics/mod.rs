@@ -5,6 +5,7 @@
 //! * [`beam`] — the 2-node beam elements: Crisfield–Jelenić (eq. 17–21) and SE(3);
 //! * [`joint`] — fixed, revolute and spherical joints as constraints (eq. 22–25);
 //! * [`model`] — nodes, rods, bodies, joints, supports, loads: a validated frame;
+//! * [`stability`] — stability of an equilibrium and the limit load;
 //! * [`statics`] — Newton–Raphson with adaptive load stepping, and
 //!   arc-length continuation (`arc_length`) through limit points.
 
@@ -17,6 +18,7 @@ pub mod frame_file;
 pub mod joint;
 pub mod model;
 pub mod rotation;
+pub mod stability;
 pub mod statics;
 
 pub use assembly::State;
@@ -25,6 +27,7 @@ pub use cable::{Cable, CableState};
 pub use frame_file::{FrameFile, FrameFileError, NodeOrigin};
 pub use joint::JointKind;
 pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, Rod, RodSpec};
+pub use stability::{limit_load_factor, LimitSearch, Stability};
 pub use statics::{
     PathControl, StaticSettings, StaticSolution, StaticSolver, StaticTermination, StepRecord,
 };

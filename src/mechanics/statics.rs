@@ -615,6 +615,20 @@ impl StaticSolver {
         Ok(state)
     }
 
+    /// The stability of `state`, an equilibrium at load factor `lambda`: is
+    /// the stiffness positive definite on the joints' constraints
+    /// ([`super::stability`])?
+    ///
+    /// # Errors
+    /// A tangent that cannot be factored (a mechanism, or exactly critical).
+    pub fn stability(
+        &self,
+        state: &State,
+        lambda: f64,
+    ) -> Result<super::stability::Stability, MechanicsError> {
+        super::stability::stability(self, &self.system, state, lambda)
+    }
+
     fn arc_length(&self, start: State, lambda0: f64, settings: &StaticSettings) -> StaticSolution {
         super::arc_length::follow(self, &self.system, start, lambda0, settings)
     }

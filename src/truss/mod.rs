@@ -12,12 +12,14 @@
 mod builder;
 mod exact;
 mod linear;
+mod margin;
 mod rigid;
 mod scene_response;
 
 pub use builder::{RingTruss, RingTrussBuilder};
 pub use exact::ExactTruss;
 pub use linear::LinearTruss;
+pub use margin::{limit_margin, PRECISION as MARGIN_PRECISION, SEARCH_TO as MARGIN_SEARCH_TO};
 pub use rigid::RigidTruss;
 pub use scene_response::{read_loads, respond, AttachmentResponse, LoadsFile, SceneTrussResponse};
 
@@ -56,6 +58,17 @@ pub enum TrussError {
     NonFiniteLoad {
         /// The attachment point.
         point: usize,
+    },
+    /// The net's pull exceeds the truss's limit load (DESIGN §9).
+    #[error(
+        "the net's pull exceeds the ring truss's limit load: its equilibrium is stable up to \
+         {stable_to:.3} × the pull and unstable (or lost) at {unstable_from:.3} ×"
+    )]
+    PastLimitLoad {
+        /// The largest multiple of the pull found stable.
+        stable_to: f64,
+        /// The least multiple found unstable.
+        unstable_from: f64,
     },
     /// No equilibrium under the full load: the truss buckles or collapses.
     #[error(

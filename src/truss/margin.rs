@@ -1,0 +1,44 @@
+//! The margin of a ring truss to its limit load under a net's pull
+//! (DESIGN §9): a design whose pull the truss cannot carry stably is an
+//! error, not a result.
+//!
+//! The one-step equilibrium the design loop asks of the exact truss cannot
+//! tell a stable state from one past a bifurcation: a ring under a symmetric
+//! pull stays on its symmetric branch past its buckling load. The margin is
+//! found on the state instead ([`crate::mechanics::stability`]): the pull is
+//! multiplied by 1, 2, 4 until the equilibrium is unstable, then bisected.
+
+use super::{check_loads, exact::nodal_loads, RingTruss, TrussError};
+use crate::mechanics::{limit_load_factor, LimitSearch, StaticSettings, StaticSolver};
+
+/// How far the margin is searched: a truss stable at this multiple of the
+/// pull is reported as such, without its limit load.
+pub const SEARCH_TO: f64 = 4.0;
+
+/// Relative width of the bracket on the limit load.
+pub const PRECISION: f64 = 0.02;
+
+/// The limit load of `truss` under multiples of `pull_n` (one force per
+/// attachment point, N), searched up to [`SEARCH_TO`] × the pull.
+///
+/// # Errors
+/// Bad loads, or a frame that cannot be analysed.
+pub fn limit_margin(truss: RingTruss, pull_n: &[[f64; 3]]) -> Result<LimitSearch, TrussError> {
+    check_loads(pull_n, truss.attachments.len())?;
+    let mut model = truss.model;
+    model.set_loads(nodal_loads(&truss.attachments, pull_n))?;
+    let mut solver = StaticSolver::new(model)?;
+    // Each solve of the search starts from a stable state close by: a step
+    // that needs cutting twice is beyond the limit, or so close to it that
+    // bisection learns as much from calling it unstable.
+    let settings = StaticSettings {
+        min_step: 1.0 / 16.0,
+        ..StaticSettings::default()
+    };
+    Ok(limit_load_factor(
+        &mut solver,
+        SEARCH_TO,
+        PRECISION,
+        &settings,
+    )?)
+}
