@@ -293,6 +293,9 @@ fn main() -> ExitCode {
                         c.slack_cables.len()
                     );
                 }
+                if let Some(m) = &r.limit_margin {
+                    say!("truss under the design's pull: {m}");
+                }
                 say!("time: {:.2} s", r.time_s);
                 for w in &r.net.warnings {
                     say!("warning: {w}");

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::design::{
-    design_loop, IterationRecord, LoopSettings, LoopTermination, Relaxation, TiedNets,
+    design_loop, DesignError, IterationRecord, LoopSettings, LoopTermination, Relaxation, TiedNets,
 };
 use crate::fdm::solve_network;
 use crate::geometry::{build_mesh, ReflectorMesh};
@@ -698,6 +698,21 @@ pub fn design(
                 history,
                 error: Some(e.to_string()),
             }),
+            // No truss equilibrium: say how far below the pull the truss's
+            // stability ends (the rigid-truss design's pull, the loop's first).
+            Err(
+                e @ DesignError::Truss {
+                    source: TrussError::NoEquilibrium { .. },
+                    ..
+                },
+            ) => {
+                let first =
+                    nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
+                return Err(match design_margin(&scene, &mesh, &first.design) {
+                    Err(past) => past,
+                    Ok(_) => e.into(),
+                });
+            }
             Err(e) => return Err(e.into()),
         }
     }

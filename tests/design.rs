@@ -5,10 +5,12 @@ use std::path::Path;
 
 use ringmesh::design::{design_loop, LoopSettings, LoopTermination, Relaxation, TiedNets};
 use ringmesh::geometry::ReflectorMesh;
-use ringmesh::run::scene_problem;
+use ringmesh::run::{design, scene_problem, DesignOptions};
 use ringmesh::scene::{Scene, TrussModel};
-use ringmesh::truss::{layout_points, oracle};
-use ringmesh::uniformity::SolverKind;
+use ringmesh::truss::{
+    layout_points, limit_margin, oracle, RingTruss, MARGIN_PRECISION, MARGIN_SEARCH_TO,
+};
+use ringmesh::uniformity::{Design, SolverKind};
 use ringmesh::verify::{verify, AssemblyTruss};
 
 fn small_hex() -> (Scene, ReflectorMesh, TiedNets) {
@@ -82,6 +84,80 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
     );
     // The conventional design's boundary is off by the truss's deflection.
     assert!(conventional.boundary_deviation_mm >= 100.0 * designed.boundary_deviation_mm);
+
+    // The truss carries the design's pull with a margin (DESIGN §9): stable
+    // to the end of the search, its lowest stiffness falling all the way.
+    let margin = limit_margin(
+        RingTruss::new(&scene, &mesh.truss).unwrap(),
+        &pull(&outcome.design),
+    )
+    .unwrap();
+    assert_eq!(margin.unstable_from, None, "{margin:?}");
+    assert_eq!(margin.stable_to, MARGIN_SEARCH_TO);
+    let stiffness: Vec<f64> = margin.path.iter().map(|p| p[1]).collect();
+    assert!(stiffness.windows(2).all(|w| w[1] < w[0]), "{stiffness:?}");
+}
+
+/// The net's pull on the truss: minus the support reactions.
+fn pull(design: &Design) -> Vec<[f64; 3]> {
+    design.reactions_n.iter().map(|r| r.map(|v| -v)).collect()
+}
+
+/// DESIGN §9: a design whose pull the truss cannot carry stably is an error,
+/// not a result. With the paper's 24/22 mm tubes small-hex's ring buckles —
+/// a bifurcation, which load control on the symmetric ring walks past and the
+/// outer loop converges through — below its net's pull.
+#[test]
+fn a_design_past_the_truss_limit_load_is_refused() {
+    let text = std::fs::read_to_string("problems/small-hex.toml")
+        .unwrap()
+        .replace(
+            "tube_outer_diameter_m = 0.060",
+            "tube_outer_diameter_m = 0.024",
+        )
+        .replace(
+            "tube_inner_diameter_m = 0.056",
+            "tube_inner_diameter_m = 0.022",
+        );
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = dir.path().join("thin.toml");
+    std::fs::write(&scene_path, &text).unwrap();
+
+    // At the theoretical boundary's design: the lowest stiffness on the
+    // path falls to near zero where the search finds the limit.
+    let scene = Scene::read(&scene_path).unwrap();
+    let (mesh, problem) = scene_problem(&scene).unwrap();
+    let nets = TiedNets::new(&mesh, problem).unwrap();
+    let solver = SolverKind::Lp.build(None);
+    let first = nets
+        .design(solver.as_ref(), &layout_points(&mesh.truss))
+        .unwrap();
+    let margin = limit_margin(
+        RingTruss::new(&scene, &mesh.truss).unwrap(),
+        &pull(&first.design),
+    )
+    .unwrap();
+    let unstable_from = margin.unstable_from.expect("the thin ring buckles");
+    assert!(margin.stable_to < 1.0 && unstable_from < 1.0, "{margin:?}");
+    assert!(unstable_from - margin.stable_to <= MARGIN_PRECISION * unstable_from);
+    let (first_stiffness, last_stiffness) = (margin.path[0][1], margin.path.last().unwrap()[1]);
+    assert!(
+        last_stiffness <= 0.1 * first_stiffness,
+        "lowest stiffness {last_stiffness} N/m at the limit, {first_stiffness} N/m unloaded"
+    );
+
+    // The design command refuses it, and writes nothing.
+    let out = dir.path().join("out");
+    let error = design(
+        &scene_path,
+        &DesignOptions::default(),
+        Some(&out),
+        &mut |_, _| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(error.contains("limit load"), "{error}");
+    assert!(!out.join("design.json").exists());
 }
 
 /// When the physics agree — a design on a rigid truss, assembled on a rigid

@@ -76,6 +76,23 @@ pub struct LimitSearch {
     pub time_s: f64,
 }
 
+impl std::fmt::Display for LimitSearch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.unstable_from {
+            Some(hi) => write!(
+                f,
+                "stable up to {:.3} × the load, unstable (or lost) at {hi:.3} ×",
+                self.stable_to
+            ),
+            None => write!(
+                f,
+                "stable up to {} × the load, the end of the search",
+                self.stable_to
+            ),
+        }
+    }
+}
+
 impl LimitSearch {
     /// The margin to the limit load: the load factor certified stable.
     pub fn margin(&self) -> f64 {

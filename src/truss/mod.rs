@@ -62,7 +62,10 @@ pub enum TrussError {
     /// The net's pull exceeds the truss's limit load (DESIGN §9).
     #[error(
         "the net's pull exceeds the ring truss's limit load: its equilibrium is stable up to \
-         {stable_to:.3} × the pull and unstable (or lost) at {unstable_from:.3} ×"
+         {} × the pull and unstable (or lost) at {} × — stiffer tubes, lower tensions or a \
+         coarser net",
+        significant(*.stable_to),
+        significant(*.unstable_from)
     )]
     PastLimitLoad {
         /// The largest multiple of the pull found stable.
@@ -94,6 +97,16 @@ impl TrussError {
                 | TrussError::NonFiniteLoad { .. }
         )
     }
+}
+
+/// `x` to three significant digits.
+fn significant(x: f64) -> String {
+    let digits = if x == 0.0 || !x.is_finite() {
+        3
+    } else {
+        (2 - x.abs().log10().floor() as i32).max(0) as usize
+    };
+    format!("{x:.digits$}")
 }
 
 /// The truss's answer to one set of attachment loads.
