@@ -7,7 +7,7 @@
 //!   tip error against the closed form, the load steps and the Newton
 //!   iterations of each size are printed once.
 //! * Group `ring_truss` — the ring truss of `problems/paper-26m.toml` (30
-//!   bays, 24/22 mm tubes) under the pull of its net, the boundary reactions
+//!   bays, 120/112 mm tubes) under the pull of its net, the boundary reactions
 //!   of forward FDM with the net's initial q, as `ringmesh truss` applies
 //!   them; ids `BenchmarkId::new("paper-26m", elements_per_rod)` with 1, 2, 4
 //!   and 8 SE(3) elements per rod. Printed once per mesh: size, Newton

@@ -97,8 +97,11 @@ fn every_shipped_scene_builds_and_balances() {
     }
 }
 
+/// Table 3 but for the tube section, which the scene enlarges so that the
+/// ring carries the paper's net (the paper's 24/22 mm tubes are stable only up
+/// to 0.005 × its pull; the reasons are in the scene file).
 #[test]
-fn paper_scene_carries_table_3_literally() {
+fn paper_scene_carries_table_3_but_the_tubes() {
     let scene = Scene::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/paper-26m.toml"))
         .unwrap();
     assert_eq!(scene.reflector.aperture_diameter_m, 26.0);
@@ -109,7 +112,7 @@ fn paper_scene_carries_table_3_literally() {
             scene.truss.tube_outer_diameter_m,
             scene.truss.tube_inner_diameter_m
         ),
-        (0.024, 0.022)
+        (0.120, 0.112)
     );
     assert_eq!(scene.truss.youngs_modulus_pa, 160e9);
     assert_eq!(
