@@ -28,6 +28,7 @@
 #![warn(missing_docs)]
 
 pub mod design;
+pub mod effects;
 pub mod fdm;
 pub mod geometry;
 pub mod mechanics;

@@ -118,6 +118,9 @@ pub struct Truss {
     /// Beam element of the flexible truss models.
     #[serde(default)]
     pub element: crate::mechanics::ElementKind,
+    /// Mass of one hinge body, kg (its weight acts under `[effects.gravity]`).
+    #[serde(default)]
+    pub hinge_mass_kg: f64,
 }
 
 /// Largest number of beam elements per truss rod.
@@ -197,6 +200,30 @@ pub enum TrussModel {
 pub struct Effects {
     /// The truss model of the design loop.
     pub truss: TrussModel,
+    /// Self weight of cables, rods and hinges (a ground test); absent: orbit.
+    pub gravity: Option<Gravity>,
+}
+
+/// Gravity: the self weight of the cables (nodal loads of the force density
+/// method) and of the truss's rods and hinges (dead loads of its model).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gravity {
+    /// Gravitational acceleration, m/s² (9.81 on the ground).
+    pub acceleration_m_per_s2: f64,
+    /// Its direction in the scene's frame (z is the reflector's axis,
+    /// pointing from the vertex to the focus): `[0, 0, -1]` for a test with
+    /// the aperture facing up, `[1, 0, 0]` with the axis horizontal.
+    pub direction: [f64; 3],
+}
+
+impl Gravity {
+    /// The acceleration vector, m/s².
+    pub fn vector_m_per_s2(&self) -> [f64; 3] {
+        let d = self.direction;
+        let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        d.map(|c| self.acceleration_m_per_s2 * c / norm)
+    }
 }
 
 /// An invalid scene: every variant names the file or the key.
@@ -337,6 +364,7 @@ impl Scene {
         positive("truss.youngs_modulus_pa", t.youngs_modulus_pa)?;
         positive("truss.shear_modulus_pa", t.shear_modulus_pa)?;
         positive("truss.density_kg_per_m3", t.density_kg_per_m3)?;
+        non_negative("truss.hinge_mass_kg", t.hinge_mass_kg)?;
 
         let f = &self.front_net;
         if f.rings < 2 {
@@ -396,6 +424,19 @@ impl Scene {
             "cables.max_force_density_n_per_m",
             c.max_force_density_n_per_m,
         )?;
+        if let Some(g) = &self.effects.gravity {
+            non_negative(
+                "effects.gravity.acceleration_m_per_s2",
+                g.acceleration_m_per_s2,
+            )?;
+            let norm = g.direction.iter().map(|c| c * c).sum::<f64>().sqrt();
+            if !(norm.is_finite() && norm > 0.0) {
+                return Err(SceneError::invalid(
+                    "effects.gravity.direction",
+                    format!("{:?} must be a finite, non-zero vector", g.direction),
+                ));
+            }
+        }
         Ok(())
     }
 

@@ -41,6 +41,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
+use crate::effects::CableSelfWeight;
 use crate::fdm::FdmStructure;
 use crate::geometry::ReflectorMesh;
 use crate::network::{CableGroup, Network};
@@ -70,6 +71,8 @@ pub struct TiedNets {
     ties: Vec<(usize, usize, usize)>,
     /// The mesh: its plan grid is rebuilt on the deformed top hinges.
     mesh: ReflectorMesh,
+    /// The cables' self weight, when the scene asks for gravity.
+    self_weight: Option<CableSelfWeight>,
 }
 
 /// A two-stage design on one boundary.
@@ -187,7 +190,20 @@ impl TiedNets {
             n_front_cables,
             ties,
             mesh: mesh.clone(),
+            self_weight: None,
         })
+    }
+
+    /// The same nets under the cables' self weight (`None`: weightless, as
+    /// in orbit): each design lumps the weight of every cable at the
+    /// geometry it designs for — the front net's, the ties to the rear
+    /// heights it starts from — half to each end node, in both stages and in
+    /// the whole network's forward solve. Along the axis the ties absorb the
+    /// vertical weight and the front net's plan problem is unchanged; across
+    /// it the weight enters plan equilibrium (front and rear).
+    pub fn with_cable_self_weight(mut self, self_weight: Option<CableSelfWeight>) -> Self {
+        self.self_weight = self_weight;
+        self
     }
 
     /// The two-stage design for attachment points `boundary_m` (top hinges,
@@ -224,11 +240,22 @@ impl TiedNets {
         for (&i, p) in network.fixed.iter().zip(boundary_m) {
             whole[i] = *p;
         }
+        let weights = self
+            .self_weight
+            .map(|w| w.nodal_loads(&whole, &network.edges));
 
         // Stage 1: the front net with vertical ties.
         let mut front_nodes = whole[..n_front].to_vec();
         front_nodes.extend(self.ties.iter().map(|&(_, _, r)| whole[r]));
-        let front = self.front.with_positions(front_nodes)?;
+        let front_loads = weights.as_ref().map(|w| {
+            let mut loads = w[..n_front].to_vec();
+            loads.resize(front_nodes.len(), [0.0; 3]);
+            loads
+        });
+        let front = self
+            .front
+            .with_positions(front_nodes)?
+            .with_loads(front_loads)?;
         let mut front_design = solver.solve(&front)?;
         if !solver.unique_design() {
             // A point of the optimal face that moves continuously with C.
@@ -248,10 +275,13 @@ impl TiedNets {
         let alpha = self.alpha(q_front);
         let rear_plan: Vec<[f64; 3]> = whole[n_front..].iter().map(|p| [p[0], p[1], 0.0]).collect();
         let mirror: Vec<f64> = q_front[..n].iter().map(|q| alpha * q).collect();
-        let q_rear = self.balance_plan(&rear_plan, &mirror)?;
-        let mut loads = vec![[0.0; 3]; rear_plan.len()];
+        let mut loads = weights.as_ref().map_or_else(
+            || vec![[0.0; 3]; rear_plan.len()],
+            |w| w[n_front..].to_vec(),
+        );
+        let q_rear = self.balance_plan(&rear_plan, &mirror, &loads)?;
         for (t, &(_, _, r)) in self.ties.iter().enumerate() {
-            loads[r - n_front][2] = front_design.tensions_n[n + t];
+            loads[r - n_front][2] += front_design.tensions_n[n + t];
         }
         let rear_nodes = whole[n_front..].to_vec();
         let rear = self.rear.solve(&q_rear, &rear_nodes, Some(&loads))?;
@@ -274,7 +304,7 @@ impl TiedNets {
         }
 
         // The whole network at its new geometry, judged by one forward solve.
-        let problem = self.full.with_positions(whole)?;
+        let problem = self.full.with_positions(whole)?.with_loads(weights)?;
         let design = Design::evaluate(
             &problem,
             &front_design.solver,
@@ -318,10 +348,16 @@ impl TiedNets {
     }
 
     /// The force densities closest to `q0` (relative least squares) in plan
-    /// equilibrium at the rear free nodes: `q = q₀ − Q₀² Aᵀ μ`,
-    /// `(A Q₀² Aᵀ) μ = A q₀`, `A` the plan equilibrium matrix (2 rows per
-    /// free node; sparse Cholesky, one refinement step).
-    fn balance_plan(&self, plan: &[[f64; 3]], q0: &[f64]) -> Result<Vec<f64>, UniformityError> {
+    /// equilibrium with the loads' plan components `p` at the rear free
+    /// nodes: `q = q₀ − Q₀² Aᵀ μ`, `(A Q₀² Aᵀ) μ = A q₀ − p`, `A` the plan
+    /// equilibrium matrix (2 rows per free node; sparse Cholesky, one
+    /// refinement step).
+    fn balance_plan(
+        &self,
+        plan: &[[f64; 3]],
+        q0: &[f64],
+        loads_n: &[[f64; 3]],
+    ) -> Result<Vec<f64>, UniformityError> {
         let structure = &self.rear;
         let rows = 2 * structure.free_nodes().len();
         let column = |k: usize| {
@@ -336,8 +372,13 @@ impl TiedNets {
             }
             entries
         };
+        // The residual `A q − p`.
         let a_times = |q: &[f64]| {
             let mut r = vec![0.0; rows];
+            for (f, &i) in structure.free_nodes().iter().enumerate() {
+                r[2 * f] -= loads_n[i][0];
+                r[2 * f + 1] -= loads_n[i][1];
+            }
             for (k, &qk) in q.iter().enumerate() {
                 for (row, v) in column(k) {
                     r[row] += v * qk;

@@ -13,8 +13,11 @@
 
 use nalgebra::Vector3;
 
+use crate::effects::{self, EffectKind};
 use crate::geometry::RingTrussLayout;
-use crate::mechanics::{JointKind, MechanicsError, Model, ModelBuilder, NodeId, RodSpec, Section};
+use crate::mechanics::{
+    JointKind, MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, RodSpec, Section,
+};
 use crate::scene::{Scene, Supports};
 
 /// A ring-truss frame and where the net attaches to it.
@@ -26,6 +29,9 @@ pub struct RingTruss {
     pub attachments: Vec<NodeId>,
     /// The supported bottom hinges and their fixed components `[x, y, z]`.
     pub supports: Vec<(usize, [bool; 3])>,
+    /// Dead loads of the truss's own weight (empty without gravity), applied
+    /// with every set of attachment loads.
+    pub self_weight: Vec<NodalLoad>,
 }
 
 fn v(p: &[f64; 3]) -> Vector3<f64> {
@@ -42,6 +48,8 @@ pub struct RingTrussBuilder {
     pub attachments: Vec<NodeId>,
     /// The supported bottom hinges and their fixed components `[x, y, z]`.
     pub supports: Vec<(usize, [bool; 3])>,
+    /// Dead loads of the truss's own weight (empty without gravity).
+    pub self_weight: Vec<NodalLoad>,
 }
 
 impl RingTruss {
@@ -54,17 +62,22 @@ impl RingTruss {
             builder,
             attachments,
             supports,
+            self_weight,
         } = Self::builder(scene, layout);
         Ok(RingTruss {
             model: builder.build()?,
             attachments,
             supports,
+            self_weight,
         })
     }
 
     /// The frame of `scene`'s truss on `layout`, not yet built (validated by
-    /// [`ModelBuilder::build`]).
+    /// [`ModelBuilder::build`]): the one place a beam model of the truss is
+    /// constructed ([`crate::effects`] logs it), with its self weight when the
+    /// scene asks for gravity.
     pub fn builder(scene: &Scene, layout: &RingTrussLayout) -> RingTrussBuilder {
+        effects::record(EffectKind::BeamModel);
         let t = &scene.truss;
         let spec = RodSpec {
             section: Section::tube(
@@ -82,6 +95,7 @@ impl RingTruss {
         let mut b = ModelBuilder::new();
         let top_hinges: Vec<NodeId> = top.iter().map(|p| b.add_body(*p)).collect();
         let bottom_hinges: Vec<NodeId> = bottom.iter().map(|p| b.add_body(*p)).collect();
+        let mut rods = Vec::new();
 
         for k in 0..n {
             let next = (k + 1) % n;
@@ -97,12 +111,14 @@ impl RingTruss {
                 bottom[k],
             );
             b.add_joint(JointKind::Fixed, batten.end(), top_hinges[k], top[k]);
+            rods.push(batten);
 
             let hinge = JointKind::Revolute { axis: normal };
             for (hinges, points) in [(&top_hinges, &top), (&bottom_hinges, &bottom)] {
                 let longeron = b.add_rod(points[k], points[next], radial_up, &spec);
                 b.add_joint(hinge, longeron.start(), hinges[k], points[k]);
                 b.add_joint(hinge, longeron.end(), hinges[next], points[next]);
+                rods.push(longeron);
             }
 
             let middle = (bottom[k] + top[next]) * 0.5;
@@ -111,6 +127,7 @@ impl RingTruss {
             b.add_joint(hinge, thick.start(), bottom_hinges[k], bottom[k]);
             b.add_joint(JointKind::Fixed, thick.end(), thin.start(), middle);
             b.add_joint(hinge, thin.end(), top_hinges[next], top[next]);
+            rods.extend([thick, thin]);
         }
 
         let supports = match t.supports {
@@ -122,11 +139,13 @@ impl RingTruss {
                 [fixed[0], fixed[1], fixed[2], false, false, false],
             );
         }
-        let attachments = top_hinges.into_iter().chain(bottom_hinges).collect();
+        let attachments: Vec<NodeId> = top_hinges.into_iter().chain(bottom_hinges).collect();
+        let self_weight = effects::truss_self_weight(scene, &b, &rods, &attachments);
         RingTrussBuilder {
             builder: b,
             attachments,
             supports,
+            self_weight,
         }
     }
 }

@@ -19,6 +19,7 @@ use crate::mechanics::{NodalLoad, NodeId, State, StaticSettings, StaticSolver};
 pub struct ExactTruss {
     solver: StaticSolver,
     attachments: Vec<NodeId>,
+    self_weight: Vec<NodalLoad>,
     points: Vec<[f64; 3]>,
     settings: StaticSettings,
     previous: Option<State>,
@@ -55,6 +56,7 @@ impl ExactTruss {
         Ok(ExactTruss {
             solver: StaticSolver::new(truss.model)?,
             attachments: truss.attachments,
+            self_weight: truss.self_weight,
             points: layout_points(layout),
             settings: StaticSettings::default(),
             previous: None,
@@ -83,7 +85,12 @@ impl TrussOracle for ExactTruss {
 
     fn respond(&mut self, loads_n: &[[f64; 3]]) -> Result<TrussResponse, TrussError> {
         let clock = Instant::now();
-        set_attachment_loads(&mut self.solver, &self.attachments, loads_n)?;
+        set_attachment_loads(
+            &mut self.solver,
+            &self.attachments,
+            &self.self_weight,
+            loads_n,
+        )?;
         let mut iterations = 0;
         let mut solution = None;
         if let Some(previous) = self.previous.take() {

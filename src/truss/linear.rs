@@ -7,12 +7,13 @@ use super::{
     layout_points, set_attachment_loads, RingTruss, TrussError, TrussOracle, TrussResponse,
 };
 use crate::geometry::RingTrussLayout;
-use crate::mechanics::StaticSolver;
+use crate::mechanics::{NodalLoad, StaticSolver};
 
 /// The ring truss as a linear frame.
 pub struct LinearTruss {
     solver: StaticSolver,
     attachments: Vec<usize>,
+    self_weight: Vec<NodalLoad>,
     points: Vec<[f64; 3]>,
 }
 
@@ -25,6 +26,7 @@ impl LinearTruss {
         Ok(LinearTruss {
             solver: StaticSolver::new(truss.model)?,
             attachments: truss.attachments,
+            self_weight: truss.self_weight,
             points: layout_points(layout),
         })
     }
@@ -41,7 +43,12 @@ impl TrussOracle for LinearTruss {
 
     fn respond(&mut self, loads_n: &[[f64; 3]]) -> Result<TrussResponse, TrussError> {
         let clock = Instant::now();
-        set_attachment_loads(&mut self.solver, &self.attachments, loads_n)?;
+        set_attachment_loads(
+            &mut self.solver,
+            &self.attachments,
+            &self.self_weight,
+            loads_n,
+        )?;
         let state = self.solver.linear_response()?;
         Ok(TrussResponse {
             positions_m: super::exact::positions(&state, &self.attachments),

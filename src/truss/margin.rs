@@ -19,14 +19,17 @@ pub const SEARCH_TO: f64 = 4.0;
 pub const PRECISION: f64 = 0.02;
 
 /// The limit load of `truss` under multiples of `pull_n` (one force per
-/// attachment point, N), searched up to [`SEARCH_TO`] × the pull.
+/// attachment point, N) with its self weight, searched up to [`SEARCH_TO`] ×
+/// the loads.
 ///
 /// # Errors
 /// Bad loads, or a frame that cannot be analysed.
 pub fn limit_margin(truss: RingTruss, pull_n: &[[f64; 3]]) -> Result<LimitSearch, TrussError> {
     check_loads(pull_n, truss.attachments.len())?;
     let mut model = truss.model;
-    model.set_loads(nodal_loads(&truss.attachments, pull_n))?;
+    let mut loads = nodal_loads(&truss.attachments, pull_n);
+    loads.extend(truss.self_weight);
+    model.set_loads(loads)?;
     let mut solver = StaticSolver::new(model)?;
     // Each solve of the search starts from a stable state close by: a step
     // that needs cutting twice is beyond the limit, or so close to it that

@@ -161,17 +161,19 @@ pub(crate) fn check_loads(loads_n: &[[f64; 3]], expected: usize) -> Result<(), T
     }
 }
 
-/// Check `loads_n` against the attachment points and set them as the dead
-/// loads of `solver`'s frame (forces at the hinge bodies `attachments`).
+/// Check `loads_n` against the attachment points and set them, with the
+/// truss's `self_weight`, as the dead loads of `solver`'s frame (forces at
+/// the hinge bodies `attachments`).
 pub(crate) fn set_attachment_loads(
     solver: &mut crate::mechanics::StaticSolver,
     attachments: &[crate::mechanics::NodeId],
+    self_weight: &[crate::mechanics::NodalLoad],
     loads_n: &[[f64; 3]],
 ) -> Result<(), TrussError> {
     check_loads(loads_n, attachments.len())?;
-    solver
-        .model_mut()
-        .set_loads(exact::nodal_loads(attachments, loads_n))?;
+    let mut loads = exact::nodal_loads(attachments, loads_n);
+    loads.extend_from_slice(self_weight);
+    solver.model_mut().set_loads(loads)?;
     Ok(())
 }
 

@@ -183,6 +183,30 @@ impl UniformityProblem {
         Ok(moved)
     }
 
+    /// The same problem under nodal loads `loads_n` (n_nodes × 3, N; `None`:
+    /// unloaded). Loads on fixed nodes only change the reactions.
+    ///
+    /// # Errors
+    /// A count that does not match, or a non-finite load (named).
+    pub fn with_loads(mut self, loads_n: Option<Vec<[f64; 3]>>) -> Result<Self, UniformityError> {
+        if let Some(loads) = &loads_n {
+            if loads.len() != self.network.n_nodes() {
+                return Err(UniformityError::Invalid(format!(
+                    "{} loads for {} nodes",
+                    loads.len(),
+                    self.network.n_nodes()
+                )));
+            }
+            if let Some(i) = loads.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+                return Err(UniformityError::Invalid(format!(
+                    "the load on node {i} is not finite"
+                )));
+            }
+        }
+        self.network.loads = loads_n;
+        Ok(self)
+    }
+
     /// The network: prescribed positions, cables, supports, loads, groups.
     pub fn network(&self) -> &Network {
         &self.network

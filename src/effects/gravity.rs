@@ -1,0 +1,100 @@
+//! Gravity (DESIGN §8): the self weight of the cables, lumped half to each
+//! end node as loads `p` of the force density method (paper eq. 3–4), and of
+//! the truss's rods (half of each element to each of its nodes) and hinge
+//! bodies, as dead loads of its model.
+//!
+//! With loads the uniformity problem is no longer homogeneous: its
+//! pretension level is no longer free, and only solvers that take loads
+//! (`bisection`) can solve it; the others say so. Along the reflector's axis
+//! the weight is vertical, and the vertical ties absorb it: the plan problem
+//! of the front net, hence its ratio, does not change. Across the axis it
+//! enters plan equilibrium and changes the optimum.
+
+use nalgebra::Vector3;
+
+use super::{record, EffectKind};
+use crate::mechanics::{ModelBuilder, NodalLoad, NodeId, Rod};
+use crate::scene::Scene;
+
+/// The self weight of a scene's cables.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CableSelfWeight {
+    /// Weight per unit length, `ρ A g`, N/m, as a vector.
+    pub weight_n_per_m: [f64; 3],
+}
+
+impl CableSelfWeight {
+    /// The cables' self weight, when the scene asks for gravity.
+    pub fn of(scene: &Scene) -> Option<Self> {
+        let g = scene.effects.gravity.as_ref()?.vector_m_per_s2();
+        record(EffectKind::CableSelfWeight);
+        let c = &scene.cables;
+        let mass_per_m =
+            c.density_kg_per_m3 * std::f64::consts::PI * c.diameter_m * c.diameter_m / 4.0;
+        Some(CableSelfWeight {
+            weight_n_per_m: g.map(|a| mass_per_m * a),
+        })
+    }
+
+    /// Nodal loads, N (n_nodes × 3): each cable's weight at the geometry
+    /// `nodes_m`, half at each end.
+    pub fn nodal_loads(&self, nodes_m: &[[f64; 3]], edges: &[[usize; 2]]) -> Vec<[f64; 3]> {
+        let mut loads = vec![[0.0; 3]; nodes_m.len()];
+        for &[i, j] in edges {
+            let (a, b) = (nodes_m[i], nodes_m[j]);
+            let length =
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+            for node in [i, j] {
+                for c in 0..3 {
+                    loads[node][c] += 0.5 * length * self.weight_n_per_m[c];
+                }
+            }
+        }
+        loads
+    }
+}
+
+/// The truss's self weight as dead loads: each element of `rods` half at each
+/// of its nodes, each of `hinges` its mass; empty when the scene does not ask
+/// for gravity.
+pub fn truss_self_weight(
+    scene: &Scene,
+    builder: &ModelBuilder,
+    rods: &[Rod],
+    hinges: &[NodeId],
+) -> Vec<NodalLoad> {
+    let Some(gravity) = &scene.effects.gravity else {
+        return Vec::new();
+    };
+    record(EffectKind::TrussSelfWeight);
+    let g = Vector3::from(gravity.vector_m_per_s2());
+    let t = &scene.truss;
+    let area = std::f64::consts::PI
+        * (t.tube_outer_diameter_m.powi(2) - t.tube_inner_diameter_m.powi(2))
+        / 4.0;
+    let weight_per_m = t.density_kg_per_m3 * area * g;
+    let position = |n: NodeId| builder.frame(n).map(|f| f.position_m);
+    let mut loads = Vec::new();
+    for rod in rods {
+        for pair in rod.nodes.windows(2) {
+            if let (Some(a), Some(b)) = (position(pair[0]), position(pair[1])) {
+                let half = 0.5 * (b - a).norm() * weight_per_m;
+                for &node in pair {
+                    loads.push(NodalLoad {
+                        node,
+                        force_n: half,
+                        moment_nm: Vector3::zeros(),
+                    });
+                }
+            }
+        }
+    }
+    if t.hinge_mass_kg > 0.0 {
+        loads.extend(hinges.iter().map(|&node| NodalLoad {
+            node,
+            force_n: t.hinge_mass_kg * g,
+            moment_nm: Vector3::zeros(),
+        }));
+    }
+    loads
+}
