@@ -469,11 +469,13 @@ fn frame_summary(o: &FrameOutput) -> String {
         .iter()
         .map(|r| norm(r.moment_nm))
         .fold(0.0, f64::max);
-    let largest = &o.nodes[o.max_displacement_node.min(o.nodes.len().saturating_sub(1))];
-    let at = match (&largest.rod, largest.rod_node, &largest.body) {
-        (Some(rod), Some(i), _) => format!("rod {rod} node {i}"),
-        (_, _, Some(body)) => format!("body {body}"),
-        _ => format!("node {}", largest.id),
+    let at = match o.nodes.get(o.max_displacement_node) {
+        Some(largest) => match (&largest.rod, largest.rod_node, &largest.body) {
+            (Some(rod), Some(i), _) => format!("rod {rod} node {i}"),
+            (_, _, Some(body)) => format!("body {body}"),
+            _ => format!("node {}", largest.id),
+        },
+        None => "no node".to_string(),
     };
     format!(
         "{}: {} nodes ({} rods, {} elements, {} bodies, {} joints); {} in {} load steps, \

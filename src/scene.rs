@@ -5,6 +5,19 @@
 //! Geometric checks that need the generated nets (ties of positive length, an
 //! unfolded grid, no degenerate cable) are made by [`crate::geometry::build_mesh`]
 //! with the same error type.
+//!
+//! # Ranges
+//!
+//! Every scene within these ranges validates, builds and has an `lp` design
+//! (the property test `tests/properties.rs` draws them at random):
+//! `aperture_diameter_m` 1…100; `focal_length_m / aperture_diameter_m`
+//! 0.15…5; `offset_m` 0…0.5 × aperture; `bays` 3…36; `rings` 2…8;
+//! `boundary_sag_ratio` 0.02…0.2; `rear_net.focal_length_m` 1…4 × the front
+//! focal length; `height_m` 1.1…2 × what the nets need,
+//! `R² (1/F + 1/F_rear)/4` (R the aperture radius); mean tensions 1…1000 N;
+//! a bound `max_force_density_n_per_m` the design does not meet is reported
+//! by the solver. Outside them a scene may still be valid; what is not is
+//! refused with the key named.
 
 use std::path::Path;
 

@@ -45,8 +45,8 @@ pub enum VerifyError {
     Mechanics(#[from] MechanicsError),
     /// The assembly found no equilibrium.
     #[error(
-        "the assembled net and truss found no equilibrium ({termination:?}, last converged \
-         prestrain factor {load_factor:.4})"
+        "the assembled net and truss found no equilibrium: the solve {termination} (last \
+         converged prestrain factor {load_factor:.4})"
     )]
     NoEquilibrium {
         /// How the static solve ended.

@@ -11,40 +11,14 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use ringmesh::mechanics::rotation::{exp, log, skew, tangent};
 use ringmesh::mechanics::{
     cantilever, ElementKind, Frame, JointKind, MechanicsError, ModelBuilder, NodeId, PathControl,
-    Rod, RodSpec, Section, State, StaticSettings, StaticSolution, StaticSolver, StaticTermination,
+    Rod, RodSpec, Section, StaticSettings, StaticSolution, StaticSolver, StaticTermination,
 };
 
+mod common;
+
+use common::{angle_between, assert_quadratic, Random};
+
 const EPS: f64 = f64::EPSILON;
-
-/// A deterministic generator (splitmix64): the tests need variety, not entropy.
-struct Random(u64);
-
-impl Random {
-    fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// A unit vector, uniform on the sphere.
-    fn axis(&mut self) -> Vector3<f64> {
-        let z = 2.0 * self.next_f64() - 1.0;
-        let phi = TAU * self.next_f64();
-        let r = (1.0 - z * z).sqrt();
-        Vector3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-}
-
-/// The angle of the rotation taking `a` to `b`, accurate down to roundoff
-/// (`2 atan2(|v|, |w|)`; nalgebra's `angle` goes through `acos` and cannot see
-/// angles below ~1e-8).
-fn angle_between(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
-    let d = a.inverse() * b;
-    2.0 * d.imag().norm().atan2(d.w.abs())
-}
 
 // ---------------------------------------------------------------------------
 // Rotations
@@ -368,113 +342,8 @@ fn se3_cantilever_is_exact_at_every_load_up_to_the_full_circle() {
     }
 }
 
-#[test]
-fn se3_cantilever_rolled_up_twice_returns_to_the_clamp() {
-    // ML/(πEI) = 4: θ = 4π, the rod winds twice round a circle of
-    // circumference L/2 and its tip comes back to the clamp (axial
-    // displacement L, vertical 0), its rotation back to the identity; every
-    // node's rotation is 4π s/L, which only multiplicative updates can follow.
-    let m_ratio = 4.0;
-    let r = cantilever::row(10, ElementKind::Se3, m_ratio, &StaticSettings::default()).unwrap();
-    assert!(r.converged);
-    let l = cantilever::LENGTH_M;
-    assert!((r.axial_m - l).abs() <= 1e-8 * l, "axial {}", r.axial_m);
-    assert!(r.vertical_m.abs() <= 1e-8 * l, "vertical {}", r.vertical_m);
-    let solver = cantilever::model(10, ElementKind::Se3, tip_moment(m_ratio)).unwrap();
-    let solution = solver.solve(&StaticSettings::default()).unwrap();
-    assert!(solution.converged());
-    let frames = rod_frames(&solver, &solution, 0);
-    for (i, f) in frames.iter().enumerate() {
-        let angle = 4.0 * PI * i as f64 / 10.0;
-        let error = angle_between(&f.rotation, &exp(&(Vector3::z() * angle)));
-        assert!(error <= 1e-9, "node {i}: rotation off by {error:e}");
-    }
-    let tip = frames.last().unwrap();
-    assert!(tip.position_m.norm() <= 1e-8 * l);
-    assert!(angle_between(&tip.rotation, &UnitQuaternion::identity()) <= 1e-9);
-    eprintln!(
-        "4π: tip |x| = {:e}, rotation {:e}, {} steps",
-        tip.position_m.norm(),
-        angle_between(&tip.rotation, &UnitQuaternion::identity()),
-        solution.steps.len()
-    );
-}
-
 // ---------------------------------------------------------------------------
 // Newton's convergence
-
-/// `solution`'s state with every node but `clamped` moved by `size` (positions
-/// by `size·length_m`, rotations by `size` rad) in fixed random directions.
-fn perturbed(
-    solution: &StaticSolution,
-    clamped: &[usize],
-    size: f64,
-    length_m: f64,
-    seed: u64,
-) -> State {
-    let mut rng = Random(seed);
-    let mut state = solution.state.clone();
-    for (n, frame) in state.frames.iter_mut().enumerate() {
-        let (dx, dt) = (rng.axis(), rng.axis());
-        if clamped.contains(&n) {
-            continue;
-        }
-        frame.position_m += dx * (size * length_m);
-        frame.rotation = exp(&(dt * size)) * frame.rotation;
-    }
-    state
-}
-
-/// Newton's residual history at the full load, starting from `start`.
-fn newton_from(solver: &StaticSolver, start: State) -> Vec<f64> {
-    let solution = solver
-        .solve_from(start, 0.0, &StaticSettings::default())
-        .unwrap();
-    assert!(solution.converged(), "{:?}", solution.termination);
-    assert_eq!(solution.rejected_steps, 0);
-    assert_eq!(solution.steps.len(), 1);
-    solution.steps[0].residuals.clone()
-}
-
-/// Newton from the equilibrium `solution` moved by δ = 1e-4, 1e-5, 1e-6: the
-/// first residual r₀ ∝ δ; with the consistent tangent the next is
-/// r₁ = C r₀² + o(r₀²), so log r₁ against log r₀ has slope 2 (an inconsistent
-/// tangent leaves slope 1). Checked on every decade, with r₁ at least 100
-/// times above the roundoff of the assembled forces, `ε · (EA/le) · |x|max`.
-/// Returns the smallest slope.
-fn assert_quadratic(
-    solver: &StaticSolver,
-    solution: &StaticSolution,
-    clamped: &[usize],
-    length_m: f64,
-    roundoff: f64,
-    what: &str,
-) -> f64 {
-    let pairs: Vec<(f64, f64)> = [1e-4, 1e-5, 1e-6]
-        .iter()
-        .map(|&size| {
-            let r = newton_from(solver, perturbed(solution, clamped, size, length_m, 7));
-            assert!(r.len() >= 2, "{what}: δ = {size} converged at once");
-            assert!(
-                r[1] >= 100.0 * roundoff,
-                "{what}: δ = {size}: r₁ = {:e} is near roundoff {roundoff:e}",
-                r[1]
-            );
-            (r[0], r[1])
-        })
-        .collect();
-    let mut smallest = f64::INFINITY;
-    for w in pairs.windows(2) {
-        let slope = (w[0].1 / w[1].1).ln() / (w[0].0 / w[1].0).ln();
-        assert!(
-            slope >= 1.8,
-            "{what}: r₁ against r₀ has slope {slope:.3} ({:?})",
-            pairs
-        );
-        smallest = smallest.min(slope);
-    }
-    smallest
-}
 
 #[test]
 fn newton_converges_quadratically_on_the_cantilever() {
@@ -487,7 +356,7 @@ fn newton_converges_quadratically_on_the_cantilever() {
             assert!(solution.converged());
             let clamp = solver.model().rods()[0].start();
             let what = format!("{kind:?} at ML/πEI = {m_ratio}");
-            let slope = assert_quadratic(&solver, &solution, &[clamp], 1.0, roundoff, &what);
+            let (slope, _) = assert_quadratic(&solver, &solution, &[clamp], 1.0, roundoff, &what);
             eprintln!("{what}: slope ≥ {slope:.4}");
         }
     }
@@ -505,7 +374,7 @@ fn newton_converges_quadratically_on_a_jointed_frame() {
         let clamped = [s.rod1.start(), s.solver.model().rods()[1].end()];
         let roundoff = EPS * cantilever::section().axial_n / 0.25 * 1.5;
         let what = format!("{joint:?} shaft");
-        let slope = assert_quadratic(&s.solver, &solution, &clamped, 1.0, roundoff, &what);
+        let (slope, _) = assert_quadratic(&s.solver, &solution, &clamped, 1.0, roundoff, &what);
         eprintln!("{what}: slope ≥ {slope:.4}");
     }
 }

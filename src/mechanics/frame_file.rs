@@ -147,6 +147,13 @@ use super::joint::JointKind;
 use super::model::{MechanicsError, Model, ModelBuilder, NodeId, Rod, RodSpec};
 use super::statics::StaticSettings;
 
+/// Most beam elements of one rod (a finer mesh buys nothing: 64 SE(3)
+/// elements are exact to roundoff on the rolled-up cantilever).
+pub const MAX_ROD_ELEMENTS: usize = 100_000;
+
+/// Most beam elements of a whole frame: bounds the memory a file can ask for.
+pub const MAX_FRAME_ELEMENTS: usize = 1_000_000;
+
 /// An invalid frame file: every variant names the file or the key.
 #[derive(Debug, thiserror::Error)]
 pub enum FrameFileError {
@@ -727,6 +734,7 @@ impl RawFile {
         let mut rods_built = Vec::with_capacity(self.rods.len());
         let mut rods_labels = Vec::with_capacity(self.rods.len());
         let mut located = Vec::new();
+        let mut total_elements = 0usize;
         for (i, r) in self.rods.iter().enumerate() {
             let key = format!("rods[{i}]");
             let label = r.name.clone().unwrap_or_else(|| key.clone());
@@ -739,6 +747,15 @@ impl RawFile {
                     format!(
                         "node {} is where the rod starts (node {}): zero length",
                         r.end, r.start
+                    ),
+                ));
+            }
+            if !(q - p).norm().is_finite() {
+                return Err(FrameFileError::invalid(
+                    format!("{key}.end"),
+                    format!(
+                        "the rod from node {} to node {} is longer than a number can hold",
+                        r.start, r.end
                     ),
                 ));
             }
@@ -777,6 +794,25 @@ impl RawFile {
                     "must be at least 1",
                 ));
             }
+            if r.elements > MAX_ROD_ELEMENTS {
+                return Err(FrameFileError::invalid(
+                    format!("{key}.elements"),
+                    format!(
+                        "{} is more than the {MAX_ROD_ELEMENTS} supported",
+                        r.elements
+                    ),
+                ));
+            }
+            total_elements += r.elements;
+            if total_elements > MAX_FRAME_ELEMENTS {
+                return Err(FrameFileError::invalid(
+                    format!("{key}.elements"),
+                    format!(
+                        "the rods up to this one have {total_elements} elements in all, more than \
+                         the {MAX_FRAME_ELEMENTS} supported"
+                    ),
+                ));
+            }
             let up = match r.up {
                 Some(u) => nonzero(&format!("{key}.up"), u)?,
                 None => Vector3::z(),
@@ -797,6 +833,12 @@ impl RawFile {
             rods_labels.push(label);
         }
 
+        if self.rods.is_empty() && self.bodies.is_empty() {
+            return Err(FrameFileError::invalid(
+                "rods",
+                "the frame has no rod and no body: nothing to solve",
+            ));
+        }
         let bodies_names = Names::new(
             "body",
             "bodies",
@@ -826,6 +868,7 @@ impl RawFile {
             members.bodies_labels.push(label);
         }
 
+        let mut joined = Vec::with_capacity(self.joints.len());
         for (i, j) in self.joints.iter().enumerate() {
             let key = format!("joints[{i}]");
             let a = members.resolve(&format!("{key}.a"), &j.a)?;
@@ -858,6 +901,7 @@ impl RawFile {
             let default = builder.frame(a).map(|f| f.position_m);
             let at = members.point(&key, &j.at, j.at_m, default)?;
             builder.add_joint(kind, a, b, at);
+            joined.push([a, b]);
         }
 
         let mut supported_nodes = Vec::new();
@@ -892,6 +936,7 @@ impl RawFile {
         }
 
         let model = builder.build()?;
+        unsupported_member(&model, &joined, &supported_nodes, &members)?;
         let bodies = members
             .bodies_labels
             .into_iter()
@@ -906,6 +951,68 @@ impl RawFile {
             supported_nodes,
         })
     }
+}
+
+/// Refuses a frame with a rod or body that no chain of elements and joints
+/// connects to a support: it could move freely, so no load has an
+/// equilibrium (its stiffness is singular). Names the first such rod, or
+/// body, with everything connected to it.
+fn unsupported_member(
+    model: &Model,
+    joined: &[[NodeId; 2]],
+    supported: &[NodeId],
+    members: &Members,
+) -> Result<(), FrameFileError> {
+    let n = model.node_count();
+    let mut parent: Vec<NodeId> = (0..n).collect();
+    fn root(parent: &mut [NodeId], mut i: NodeId) -> NodeId {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let pairs = model
+        .rods()
+        .iter()
+        .flat_map(|rod| rod.nodes.windows(2).map(|w| [w[0], w[1]]))
+        .chain(joined.iter().copied());
+    for [a, b] in pairs {
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        parent[ra] = rb;
+    }
+    let mut held = vec![false; n];
+    for &s in supported {
+        let r = root(&mut parent, s);
+        held[r] = true;
+    }
+    let loose = |node: NodeId, parent: &mut [NodeId]| !held[root(parent, node)];
+    let rods = model.rods().iter().enumerate().map(|(i, rod)| {
+        (
+            format!("rods[{i}]"),
+            format!("rod {}", members.rods_labels[i]),
+            rod.start(),
+        )
+    });
+    let bodies = members.bodies_nodes.iter().enumerate().map(|(i, &node)| {
+        (
+            format!("bodies[{i}]"),
+            format!("body {}", members.bodies_labels[i]),
+            node,
+        )
+    });
+    for (key, label, node) in rods.chain(bodies) {
+        if loose(node, &mut parent) {
+            return Err(FrameFileError::invalid(
+                key,
+                format!(
+                    "{label} is not connected to any support through rods and joints: it \
+                     could move freely (add a [[supports]] or a joint to a supported member)"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -307,7 +307,11 @@ impl ModelBuilder {
         if !(length.is_finite() && length > 0.0) {
             self.errors.push(MechanicsError::invalid(
                 &item,
-                "start and end coincide (zero length)",
+                if length.is_finite() {
+                    "start and end coincide (zero length)"
+                } else {
+                    "its length is not a finite number"
+                },
             ));
             self.rods.push(Rod { nodes: vec![] });
             return self.rods.last().cloned().expect("just pushed");

@@ -54,6 +54,29 @@ pub enum StaticTermination {
     },
 }
 
+impl std::fmt::Display for StaticTermination {
+    /// One clause a person can read: `passed a limit point at load factor
+    /// 0.6555 (the structure carries about 0.6555 × the applied loads)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StaticTermination::Converged => f.write_str("converged at the full load"),
+            StaticTermination::Stalled { load_factor } => write!(
+                f,
+                "stalled: Newton stopped converging at load factor {load_factor:.4}, with no \
+                 sign of instability"
+            ),
+            StaticTermination::LimitPoint { limit_load_factor } => write!(
+                f,
+                "passed a limit point at load factor {limit_load_factor:.4} (the structure \
+                 carries about {limit_load_factor:.4} × the applied loads)"
+            ),
+            StaticTermination::MaxSteps { load_factor } => {
+                write!(f, "ran out of load steps at load factor {load_factor:.4}")
+            }
+        }
+    }
+}
+
 /// How the load is followed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]

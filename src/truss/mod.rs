@@ -75,8 +75,8 @@ pub enum TrussError {
     },
     /// No equilibrium under the full load: the truss buckles or collapses.
     #[error(
-        "the ring truss found no equilibrium under the net's pull ({termination:?}, last converged \
-         load factor {load_factor:.4}): the loads exceed what the truss can carry"
+        "the ring truss found no equilibrium under the net's pull: it {termination}; the loads \
+         exceed what the truss can carry (last converged load factor {load_factor:.4})"
     )]
     NoEquilibrium {
         /// How the static solve ended.

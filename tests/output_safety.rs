@@ -1,0 +1,168 @@
+//! Output safety (issue 7): every result file is written to a temporary file
+//! and renamed, so a run killed mid-way leaves the previous results intact
+//! and readable.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// Every file of a folder with its bytes, by name.
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let path = e.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read(&path).unwrap())
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// `ringmesh design` on a copy of realistic-26m (≈ 3 s) writes its results;
+/// a second run on the same folder, killed (SIGKILL) as soon as it reports
+/// its first outer iteration, leaves every file byte for byte as the first
+/// run wrote it — `design.json` parses, `cables.csv` has its header and a
+/// row per cable — and no temporary file behind.
+#[test]
+fn a_design_run_killed_in_its_outer_loop_leaves_the_previous_results_intact() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("realistic-26m.toml");
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/realistic-26m.toml"),
+        &scene,
+    )
+    .unwrap();
+    let out: PathBuf = dir.path().join("results").join("realistic-26m");
+    let args = [
+        "design",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    let first = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    let before = snapshot(&out);
+    let names: Vec<&str> = before.iter().map(|(n, _)| n.as_str()).collect();
+    for expected in ["design.json", "cables.csv", "convergence.csv", "model.vtu"] {
+        assert!(names.contains(&expected), "{names:?}");
+    }
+
+    let mut second = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = BufReader::new(second.stderr.take().unwrap());
+    let mut line = String::new();
+    let mut seen = Vec::new();
+    loop {
+        line.clear();
+        let read = stderr.read_line(&mut line).unwrap();
+        assert!(read > 0, "the run ended before its outer loop: {seen:?}");
+        seen.push(line.clone());
+        if line.contains("boundary change") {
+            break;
+        }
+    }
+    second.kill().unwrap();
+    let status = second.wait().unwrap();
+    assert!(!status.success(), "the run finished before it was killed");
+
+    let after = snapshot(&out);
+    assert_eq!(
+        after.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+        before.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+        "files appeared or vanished (temporary files left?)"
+    );
+    for ((name, a), (_, b)) in after.iter().zip(&before) {
+        assert!(a == b, "{name} changed");
+    }
+    let design: serde_json::Value =
+        serde_json::from_slice(&after.iter().find(|(n, _)| n == "design.json").unwrap().1).unwrap();
+    assert_eq!(design["scene"], "realistic-26m");
+    let csv = String::from_utf8(
+        after
+            .iter()
+            .find(|(n, _)| n == "cables.csv")
+            .unwrap()
+            .1
+            .clone(),
+    )
+    .unwrap();
+    assert!(csv.starts_with("id,group,i,j,q,tension_n,length_m,cut_length_m\n"));
+    let cables = design["net"]["q"].as_array().unwrap().len();
+    assert_eq!(csv.lines().count(), cables + 1);
+    eprintln!(
+        "killed after: {}; {} files intact",
+        seen.last().unwrap().trim(),
+        after.len()
+    );
+}
+
+/// Every file the library writes goes through `report::write_atomic` (or
+/// `write_atomic_with` for the plot backends, which draw to its temporary
+/// path): no other place in `src/` creates or writes a file.
+#[test]
+fn only_the_atomic_writers_touch_the_file_system() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut stack = vec![src.clone()];
+    let mut offenders = Vec::new();
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            let relative = path
+                .strip_prefix(&src)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
+            for (n, line) in text.lines().enumerate() {
+                let writes = ["File::create", "fs::write", "OpenOptions", "fs::copy"]
+                    .iter()
+                    .any(|w| line.contains(w));
+                let draws = ["BitMapBackend::new(", "SVGBackend::new("]
+                    .iter()
+                    .any(|w| line.contains(w))
+                    && !line.contains("temporary");
+                if (writes && relative != "report/mod.rs") || draws {
+                    offenders.push(format!("src/{relative}:{}: {}", n + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(offenders.is_empty(), "non-atomic writes: {offenders:#?}");
+}
+
+/// A write interrupted half-way (the drawing fails after writing part of
+/// its file) leaves the previous file whole and no temporary file behind.
+#[test]
+fn an_interrupted_write_leaves_the_previous_file_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("design.json");
+    ringmesh::report::write_json(&path, &vec![1, 2, 3]).unwrap();
+    let before = std::fs::read(&path).unwrap();
+    let result = ringmesh::report::write_atomic_with(&path, |temporary| {
+        std::fs::write(temporary, b"[4, 5").map_err(|e| e.to_string())?;
+        Err("interrupted".to_string())
+    });
+    assert_eq!(result, Err("interrupted".to_string()));
+    assert_eq!(std::fs::read(&path).unwrap(), before);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
