@@ -9,6 +9,7 @@ use serde::Serialize;
 use crate::design::{
     design_loop, DesignError, IterationRecord, LoopSettings, LoopTermination, Relaxation, TiedNets,
 };
+use crate::effects::CableSelfWeight;
 use crate::fdm::solve_network;
 use crate::geometry::{build_mesh, ReflectorMesh};
 use crate::mechanics::cantilever::{self, CantileverRow};
@@ -109,7 +110,8 @@ pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutput, Error> 
     Ok(output)
 }
 
-/// The uniformity problem of a scene's front net for its theoretical boundary.
+/// The uniformity problem of a scene's front net for its theoretical boundary,
+/// under the cables' self weight when the scene asks for gravity.
 pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem), Error> {
     let mesh = build_mesh(scene)?;
     let mut problem = UniformityProblem::from_mesh(
@@ -118,7 +120,9 @@ pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem)
         scene.cables.max_force_density_n_per_m,
     )?;
     problem.min_tension_fraction = scene.uniformity.min_tension_fraction;
-    Ok((mesh, problem))
+    let weights =
+        CableSelfWeight::of(scene).map(|w| w.nodal_loads(&mesh.network.nodes, &mesh.network.edges));
+    Ok((mesh, problem.with_loads(weights)?))
 }
 
 /// `design.json`: the scene's name and the design.
@@ -647,7 +651,7 @@ pub fn design(
     let scene = Scene::read(scene_path)?;
     let model = options.truss.unwrap_or(scene.effects.truss);
     let (mesh, problem) = scene_problem(&scene)?;
-    let nets = TiedNets::new(&mesh, problem)?;
+    let nets = TiedNets::new(&mesh, problem)?.with_cable_self_weight(CableSelfWeight::of(&scene));
     let solver = options.solver.build(None);
     let relaxations = if options.relaxations.is_empty() {
         vec![Relaxation::default()]

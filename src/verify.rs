@@ -139,7 +139,7 @@ pub fn verify(
         )));
     }
 
-    let (mut b, attachments) = match truss {
+    let (mut b, attachments, self_weight) = match truss {
         AssemblyTruss::Rigid => {
             let mut b = ModelBuilder::new();
             let points = hinges
@@ -150,15 +150,16 @@ pub fn verify(
                     n
                 })
                 .collect::<Vec<_>>();
-            (b, points)
+            (b, points, Vec::new())
         }
         AssemblyTruss::Flexible => {
             let RingTrussBuilder {
                 builder,
                 attachments,
+                self_weight,
                 ..
             } = RingTruss::builder(scene, layout);
-            (builder, attachments)
+            (builder, attachments, self_weight)
         }
     };
     // Net node → model node: attachments for the fixed ones, new points for the
@@ -176,6 +177,16 @@ pub fn verify(
         .into_iter()
         .map(|n| n.expect("every node mapped"))
         .collect();
+    // The effects' dead loads: the truss's self weight, and the net's nodal
+    // loads of the design (the cables' self weight, lumped as designed).
+    for l in self_weight {
+        b.add_load(l.node, l.force_n, l.moment_nm);
+    }
+    for (i, p) in network.loads.iter().flatten().enumerate() {
+        if p.iter().any(|&v| v != 0.0) {
+            b.add_load(node_of[i], vector(p), nalgebra::Vector3::zeros());
+        }
+    }
     let ea = scene.cables.axial_stiffness_n();
     let mut ramped = b.clone();
     for (k, &[i, j]) in network.edges.iter().enumerate() {

@@ -54,6 +54,24 @@ use crate::uniformity::{
 /// this fraction of the solver's: unique, and continuous in the boundary.
 pub const SELECTION_SLACK: f64 = 1e-3;
 
+/// Relative change of the lumped cable weights at which a design under
+/// gravity stops repeating its stages.
+const WEIGHT_TOLERANCE: f64 = 1e-13;
+
+/// Most passes of the stages under gravity.
+const MAX_WEIGHT_PASSES: usize = 8;
+
+/// Largest component difference of two load lists (`b` may be empty: zero).
+fn max_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    a.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let q = b.get(i).copied().unwrap_or([0.0; 3]);
+            (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
+}
+
 /// A reflector's front net, rear net and ties, split for the two-stage design.
 #[derive(Debug, Clone)]
 pub struct TiedNets {
@@ -226,7 +244,7 @@ impl TiedNets {
                 network.fixed.len()
             )));
         }
-        let (n_front, n) = (self.n_front, self.n_front_cables);
+        let n_front = self.n_front;
         // The plan grid rebuilt on the top hinges' plan positions: the free
         // nodes move with the boundary (front on the paraboloid, rear below).
         let plan = self
@@ -240,14 +258,62 @@ impl TiedNets {
         for (&i, p) in network.fixed.iter().zip(boundary_m) {
             whole[i] = *p;
         }
-        let weights = self
+        // Without weight one pass; with it, the weight of the ties depends on
+        // the rear heights stage 2 finds: repeat until the lumped weights are
+        // those of the geometry designed (a few passes: they change little).
+        let mut weights = self
             .self_weight
             .map(|w| w.nodal_loads(&whole, &network.edges));
+        let mut passes = 0;
+        let (front_design, q, alpha) = loop {
+            passes += 1;
+            let (front_design, q, alpha) = self.stages(solver, &mut whole, weights.as_deref())?;
+            let Some(w) = self.self_weight else {
+                break (front_design, q, alpha);
+            };
+            let new = w.nodal_loads(&whole, &network.edges);
+            let change = max_difference(&new, weights.as_deref().unwrap_or(&[]));
+            let scale = max_difference(&new, &[]);
+            if change <= WEIGHT_TOLERANCE * scale || passes >= MAX_WEIGHT_PASSES {
+                // The weights of this pass: the design balances them exactly.
+                break (front_design, q, alpha);
+            }
+            weights = Some(new);
+        };
 
+        // The whole network at its new geometry, judged by one forward solve.
+        let problem = self.full.with_positions(whole)?.with_loads(weights)?;
+        let design = Design::evaluate(
+            &problem,
+            &front_design.solver,
+            q,
+            front_design.termination,
+            front_design.iterations,
+            clock.elapsed(),
+            front_design.warnings,
+        )?;
+        Ok(TiedDesign {
+            design,
+            problem,
+            alpha,
+        })
+    }
+
+    /// The two stages on the geometry `whole` (front nodes and boundary
+    /// final, rear heights a start) under the nodal `weights`: the front
+    /// design, every `q`, and `α`; `whole` gets the rear heights found.
+    fn stages(
+        &self,
+        solver: &dyn UniformitySolver,
+        whole: &mut [[f64; 3]],
+        weights: Option<&[[f64; 3]]>,
+    ) -> Result<(Design, Vec<f64>, f64), UniformityError> {
+        let network = self.full.network();
+        let (n_front, n) = (self.n_front, self.n_front_cables);
         // Stage 1: the front net with vertical ties.
         let mut front_nodes = whole[..n_front].to_vec();
         front_nodes.extend(self.ties.iter().map(|&(_, _, r)| whole[r]));
-        let front_loads = weights.as_ref().map(|w| {
+        let front_loads = weights.map(|w| {
             let mut loads = w[..n_front].to_vec();
             loads.resize(front_nodes.len(), [0.0; 3]);
             loads
@@ -303,22 +369,7 @@ impl TiedNets {
             q[k] = front_design.tensions_n[n + t] / length;
         }
 
-        // The whole network at its new geometry, judged by one forward solve.
-        let problem = self.full.with_positions(whole)?.with_loads(weights)?;
-        let design = Design::evaluate(
-            &problem,
-            &front_design.solver,
-            q,
-            front_design.termination,
-            front_design.iterations,
-            clock.elapsed(),
-            front_design.warnings,
-        )?;
-        Ok(TiedDesign {
-            design,
-            problem,
-            alpha,
-        })
+        Ok((front_design, q, alpha))
     }
 
     /// The rear level `α` that best balances the nominal rear net vertically
