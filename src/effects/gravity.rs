@@ -45,8 +45,8 @@ impl CableSelfWeight {
             let length =
                 ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
             for node in [i, j] {
-                for c in 0..3 {
-                    loads[node][c] += 0.5 * length * self.weight_n_per_m[c];
+                for (load, w) in loads[node].iter_mut().zip(self.weight_n_per_m) {
+                    *load += 0.5 * length * w;
                 }
             }
         }
