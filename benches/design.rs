@@ -16,7 +16,10 @@
 use std::path::Path;
 use std::time::Duration;
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::measurement::WallTime;
+use criterion::{
+    criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion, SamplingMode,
+};
 use ringmesh::design::{LoopOutcome, LoopSettings};
 use ringmesh::run::SceneNets;
 use ringmesh::scene::{Scene, TrussModel};
@@ -66,6 +69,20 @@ fn model_name(model: TrussModel) -> &'static str {
     }
 }
 
+/// 4 s of samples for the small scene; 10 flat samples of the large one
+/// (half a second each).
+fn measure_time(group: &mut BenchmarkGroup<'_, WallTime>, f: &Fixture) {
+    if f.name == "small-hex" {
+        group
+            .sampling_mode(SamplingMode::Auto)
+            .measurement_time(Duration::from_secs(4));
+    } else {
+        group
+            .sampling_mode(SamplingMode::Flat)
+            .measurement_time(Duration::from_secs(8));
+    }
+}
+
 fn bench_design(c: &mut Criterion) {
     let fixtures = [Fixture::new("small-hex"), Fixture::new("realistic-26m")];
     let cases = [
@@ -89,11 +106,9 @@ fn bench_design(c: &mut Criterion) {
     }
 
     let mut group = c.benchmark_group("design_loop");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(5));
+    group.sample_size(10).warm_up_time(Duration::from_secs(1));
     for (f, model) in cases {
+        measure_time(&mut group, f);
         group.bench_with_input(
             BenchmarkId::new(f.name, model_name(model)),
             &(f, model),
@@ -103,11 +118,9 @@ fn bench_design(c: &mut Criterion) {
     group.finish();
 
     let mut group = c.benchmark_group("verify");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(5));
+    group.sample_size(10).warm_up_time(Duration::from_secs(1));
     for f in &fixtures {
+        measure_time(&mut group, f);
         let outcome = f.design(TrussModel::Exact);
         let network = outcome.problem.network();
         group.bench_function(f.name, |b| {
