@@ -35,7 +35,8 @@
 //! the optimum with the net, and what its density buys is `facet_rms_mm`.
 //!
 //! A point that fails (no truss equilibrium, no assembled equilibrium) is a row
-//! with its error, not a failed study; only a failed reference stops it.
+//! with its error, not a failed study; only a reference that fails or does not
+//! converge stops it.
 //! Points run in a deterministic order, so a sweep splits into shards
 //! ([`crate::shard`]); every shard runs the reference itself to judge its
 //! points.
@@ -584,7 +585,8 @@ fn row(
 /// in sweep order.
 ///
 /// # Errors
-/// Invalid settings, worker threads that cannot start, or a failed reference.
+/// Invalid settings, worker threads that cannot start, or a reference that
+/// fails or does not converge.
 pub fn run_study(
     scene: &Scene,
     settings: &StudySettings,
@@ -603,11 +605,21 @@ pub fn run_study(
         max_iterations,
         judge_elements,
     );
+    let failed = |message: String| StudyError::Reference {
+        settings: reference_point.settings.to_string(),
+        message,
+    };
+    if let Some(s) = measured.summary.as_ref() {
+        if s.termination != LoopTermination::Converged {
+            return Err(failed(format!(
+                "its outer loop stopped {:?} after {} iterations (residual {:.3e} m): a \
+                 yardstick must be converged",
+                s.termination, s.iterations, s.residual_m
+            )));
+        }
+    }
     let Some(reference) = measured.judged.as_ref() else {
-        return Err(StudyError::Reference {
-            settings: reference_point.settings.to_string(),
-            message: measured.error.unwrap_or_default(),
-        });
+        return Err(failed(measured.error.clone().unwrap_or_default()));
     };
     let reference_rings = reference_point.settings.rings;
     let reference_row = row(reference_point, &measured, reference, reference_rings);
