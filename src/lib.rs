@@ -24,7 +24,10 @@
 //! * [`truss`] — the ring truss and its response oracles (rigid, linear, exact);
 //! * [`design`] — the outer loop: net design and truss response to a fixed point;
 //! * [`verify`] — the design cut to length and assembled on the flexible truss;
-//! * [`report`] — files a run writes (atomically): JSON, CSV, VTK, plots.
+//! * [`report`] — files a run writes (atomically): JSON, CSV, VTK, plots;
+//! * [`study`] — what accuracy costs in time: one knob at a time against a
+//!   converged reference;
+//! * [`shard`] — sweeps split across machines and merged back.
 #![warn(missing_docs)]
 
 pub mod design;
@@ -36,6 +39,8 @@ pub mod network;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod shard;
+pub mod study;
 pub mod truss;
 pub mod uniformity;
 pub mod verify;
@@ -74,6 +79,12 @@ pub enum Error {
     /// The assembled verification failed.
     #[error(transparent)]
     Verify(#[from] verify::VerifyError),
+    /// The accuracy study cannot run.
+    #[error(transparent)]
+    Study(#[from] study::StudyError),
+    /// A bad shard, or shards that cannot be merged.
+    #[error(transparent)]
+    Shard(#[from] shard::ShardError),
 }
 
 impl Error {
@@ -88,6 +99,8 @@ impl Error {
             Error::Truss(e) => e.is_bad_input(),
             Error::Frame(e) => e.is_bad_input(),
             Error::Design(e) => e.is_bad_input(),
+            Error::Study(e) => e.is_bad_input(),
+            Error::Shard(e) => e.is_bad_input(),
             Error::Verify(e) => matches!(
                 e,
                 verify::VerifyError::Mechanics(mechanics::MechanicsError::Invalid { .. })

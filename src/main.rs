@@ -10,6 +10,8 @@ use ringmesh::design::Relaxation;
 use ringmesh::mechanics::{ElementKind, StaticTermination};
 use ringmesh::run::{CantileverTable, FrameOutput, Progress};
 use ringmesh::scene::TrussModel;
+use ringmesh::shard::Shard;
+use ringmesh::study::Knob;
 use ringmesh::uniformity::SolverKind;
 
 /// Prints a line to stdout; a closed pipe (`ringmesh … | head`) is not an error.
@@ -155,6 +157,79 @@ enum Command {
         /// Knob values per solver.
         #[arg(long, default_value_t = 8)]
         points: usize,
+        /// Run only shard I of N (from 0: point k runs when k mod N = I) and
+        /// write front.shard-I-of-N.csv; join the shards with `ringmesh merge`.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<Shard>,
+        /// Output folder [default: results/<scene name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// What accuracy costs in time: the design's wall time against its accuracy
+    /// as built, one knob at a time from the scene's settings.
+    ///
+    /// Knobs: outer-loop tolerance, elements per truss rod, front-net rings,
+    /// truss model, uniformity solver. Every design is cut to length and
+    /// assembled on the reference truss (exact, the most elements) and judged
+    /// against the reference run (finest settings, the scene's net): surface
+    /// RMS (mm), ratio error, tension change, cut-length error, facet RMS.
+    /// Writes accuracy-vs-time.csv, .png and .svg (log-log, Pareto-optimal
+    /// points ringed); a failed point is a row with its error.
+    ///
+    /// Example: ringmesh study problems/realistic-26m.toml
+    Study {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// Knobs to sweep, comma-separated.
+        #[arg(
+            long,
+            value_enum,
+            value_delimiter = ',',
+            default_value = "tolerance,elements,rings,truss,solver"
+        )]
+        knobs: Vec<Knob>,
+        /// Outer-loop tolerances, m [default: 1e-2,1e-3,1e-4,1e-5,1e-6,1e-7].
+        #[arg(long, value_delimiter = ',')]
+        tolerances: Option<Vec<f64>>,
+        /// Elements per truss rod [default: 1,2,4,8,16].
+        #[arg(long, value_delimiter = ',')]
+        elements: Option<Vec<usize>>,
+        /// Front-net rings [default: r/2, r, 3r/2, 2r about the scene's r].
+        #[arg(long, value_delimiter = ',')]
+        rings: Option<Vec<usize>>,
+        /// Truss models [default: rigid,linear,exact].
+        #[arg(long, value_enum, value_delimiter = ',')]
+        trusses: Option<Vec<TrussModel>>,
+        /// Uniformity solvers [default: lp,bisection,least-squares,gradient].
+        #[arg(long, value_enum, value_delimiter = ',')]
+        solvers: Option<Vec<SolverKind>>,
+        /// Most outer iterations of a run [default: 50].
+        #[arg(long)]
+        max_iterations: Option<usize>,
+        /// Points run at once (1: one after the other, so each is timed alone).
+        #[arg(long, default_value_t = 1, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
+        jobs: usize,
+        /// Run only shard I of N (from 0: point k runs when k mod N = I; every
+        /// shard also runs the reference) and write
+        /// accuracy-vs-time.shard-I-of-N.csv; join with `ringmesh merge`.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<Shard>,
+        /// Output folder [default: results/<scene name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Join the shards of `front` or `study` runs into one table and plot.
+    ///
+    /// Takes shard files or folders holding *.shard-I-of-N.csv; each command's
+    /// shards must be all of 0..N of one sweep of one scene with the same
+    /// settings, else nothing is written. Writes front.csv/.png/.svg or
+    /// accuracy-vs-time.csv/.png/.svg.
+    ///
+    /// Example: ringmesh merge results/realistic-26m
+    Merge {
+        /// Shard files, or folders holding them.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
         /// Output folder [default: results/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -222,6 +297,16 @@ impl Progress for Bar {
         self.0.set_message(message.to_string());
         self.0.inc(1);
     }
+}
+
+/// A progress bar on stderr, hidden when stderr is not a terminal.
+fn bar() -> Bar {
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
+            .expect("valid template"),
+    );
+    Bar(bar)
 }
 
 fn main() -> ExitCode {
@@ -366,16 +451,18 @@ fn main() -> ExitCode {
             scene,
             solvers,
             points,
+            shard,
             output,
         } => {
-            let bar = ProgressBar::new(0);
-            bar.set_style(
-                ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
-                    .expect("valid template"),
+            let progress = bar();
+            let result = ringmesh::run::front(
+                scene,
+                solvers,
+                *points,
+                output.as_deref(),
+                *shard,
+                &progress,
             );
-            let progress = Bar(bar);
-            let result =
-                ringmesh::run::front(scene, solvers, *points, output.as_deref(), &progress);
             progress.0.finish_and_clear();
             result.map(|(points, written)| {
                 for p in &points {
@@ -393,6 +480,81 @@ fn main() -> ExitCode {
                 }
                 for path in written {
                     say!("wrote {}", path.display());
+                }
+            })
+        }
+        Command::Study {
+            scene,
+            knobs,
+            tolerances,
+            elements,
+            rings,
+            trusses,
+            solvers,
+            max_iterations,
+            jobs,
+            shard,
+            output,
+        } => {
+            let options = ringmesh::run::StudyOptions {
+                knobs: knobs.clone(),
+                tolerances_m: tolerances.clone(),
+                elements_per_rod: elements.clone(),
+                rings: rings.clone(),
+                truss_models: trusses.clone(),
+                solvers: solvers.clone(),
+                max_iterations: *max_iterations,
+                jobs: *jobs,
+            };
+            let progress = bar();
+            let result = ringmesh::run::study(scene, &options, output.as_deref(), *shard, &progress);
+            progress.0.finish_and_clear();
+            result.map(|outcome| {
+                say!(
+                    "{}: {} of {} points (time: design wall time; accuracy: as built on the reference truss)",
+                    outcome.scene,
+                    outcome.rows.len(),
+                    outcome.points
+                );
+                say!(
+                    "{:>5} {:>10} {:>13} {:>9} {:>10} {:>11} {:>11} {:>13} {:>13}",
+                    "point", "knob", "value", "time s", "RMS mm", "ratio err", "tension %", "cut len mm", "facet RMS mm"
+                );
+                for (k, r) in &outcome.rows {
+                    let value = if r.value.is_empty() { "-" } else { &r.value };
+                    let g = |v: f64| if v.is_finite() { format!("{v:.3e}") } else { "-".into() };
+                    match &r.error {
+                        Some(e) => say!("{k:>5} {:>10} {value:>13} {:>9.3}  failed: {e}", r.knob.name(), r.time_s),
+                        None => say!(
+                            "{k:>5} {:>10} {value:>13} {:>9.3} {:>10} {:>11} {:>11} {:>13} {:>13}",
+                            r.knob.name(),
+                            r.time_s,
+                            g(r.rms_mm),
+                            g(r.ratio_error),
+                            g(r.tension_change_pct),
+                            g(r.cut_length_error_mm),
+                            g(r.facet_rms_mm)
+                        ),
+                    }
+                }
+                for path in &outcome.written {
+                    say!("wrote {}", path.display());
+                }
+            })
+        }
+        Command::Merge { paths, output } => {
+            ringmesh::run::merge(paths, output.as_deref()).map(|outcomes| {
+                for m in outcomes {
+                    say!(
+                        "{} of {}: {} shards, {} rows",
+                        m.command,
+                        m.scene,
+                        m.shards,
+                        m.rows
+                    );
+                    for path in &m.written {
+                        say!("wrote {}", path.display());
+                    }
                 }
             })
         }

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::design::{
-    design_loop, DesignError, IterationRecord, LoopSettings, LoopTermination, Relaxation, TiedNets,
+    design_loop, DesignError, IterationRecord, LoopOutcome, LoopSettings, LoopTermination,
+    Relaxation, TiedNets,
 };
 use crate::effects::CableSelfWeight;
 use crate::fdm::solve_network;
@@ -19,14 +20,17 @@ use crate::mechanics::{
 };
 use crate::network::{norm3, Network, NetworkSummary};
 use crate::report::{
-    assembly_vtu, cables_csv, convergence_plot, front_csv, front_plot, network_vtu, surface_plot,
-    write_atomic, write_json,
+    assembly_vtu, cables_csv, convergence_plot, front_csv, front_plot, front_row, network_vtu,
+    parse_front_row, parse_study_row, study_csv, study_plot, study_row, surface_plot, write_atomic,
+    write_json, FrontRow, FRONT_COLUMNS, STUDY_COLUMNS,
 };
 use crate::scene::{Scene, TrussModel};
+use crate::shard::{self, Shard, ShardError, ShardHeader};
+use crate::study::{self, Knob, StudyRow, StudySettings};
 use crate::truss::{RingTruss, SceneTrussResponse, TrussError};
 use crate::uniformity::{
-    design_front, Design, FrontPoint, SolverKind, SurfaceTarget, Termination, UniformityError,
-    UniformityProblem, UniformitySet,
+    design_front_points, front_jobs, Design, FrontPoint, SolverKind, SurfaceTarget, Termination,
+    UniformityError, UniformityProblem, UniformitySet, UniformitySolver,
 };
 use crate::verify::{verify, AssemblyTruss, Verification};
 use crate::Error;
@@ -123,6 +127,52 @@ pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem)
     let weights =
         CableSelfWeight::of(scene).map(|w| w.nodal_loads(&mesh.network.nodes, &mesh.network.edges));
     Ok((mesh, problem.with_loads(weights)?))
+}
+
+/// A scene's nets ready for the outer loop: the mesh and its two-stage
+/// design problem ([`TiedNets`]).
+pub struct SceneNets {
+    /// The scene's nets and truss layout.
+    pub mesh: ReflectorMesh,
+    /// The two-stage design problem on them.
+    pub nets: TiedNets,
+}
+
+impl SceneNets {
+    /// Builds the mesh and the design problem of `scene`.
+    ///
+    /// # Errors
+    /// An invalid mesh or uniformity problem.
+    pub fn new(scene: &Scene) -> Result<SceneNets, Error> {
+        let (mesh, problem) = scene_problem(scene)?;
+        let nets =
+            TiedNets::new(&mesh, problem)?.with_cable_self_weight(CableSelfWeight::of(scene));
+        Ok(SceneNets { mesh, nets })
+    }
+
+    /// One run of the outer loop (net design ⇄ truss response) with a fresh
+    /// truss oracle of `model` (the scene's truss values), calling `observe`
+    /// after every iteration.
+    ///
+    /// # Errors
+    /// A truss that cannot be built, or the loop's errors.
+    pub fn design_loop(
+        &self,
+        scene: &Scene,
+        solver: &dyn UniformitySolver,
+        model: TrussModel,
+        settings: &LoopSettings,
+        observe: &mut dyn FnMut(&IterationRecord),
+    ) -> Result<LoopOutcome, Error> {
+        let mut oracle = crate::truss::oracle(model, scene, &self.mesh.truss)?;
+        Ok(design_loop(
+            &self.nets,
+            solver,
+            oracle.as_mut(),
+            settings,
+            observe,
+        )?)
+    }
 }
 
 /// `design.json`: the scene's name and the design.
@@ -261,37 +311,323 @@ pub fn uniformity(
 }
 
 /// `ringmesh front`: the design front of a scene (each solver's knob swept in
-/// parallel), written as `front.csv`, `front.png` and `front.svg`.
+/// parallel), written as `front.csv`, `front.png` and `front.svg`; with a
+/// `shard`, only that shard's points, written as `front.shard-I-of-N.csv`
+/// (see [`crate::shard`]; `ringmesh merge` makes the table and the plot).
 pub fn front(
     scene_path: &Path,
     solvers: &[SolverKind],
     points: usize,
     output_dir: Option<&Path>,
+    shard: Option<Shard>,
     progress: &dyn Progress,
 ) -> Result<(Vec<FrontPoint>, Vec<PathBuf>), Error> {
     let scene = Scene::read(scene_path)?;
     let (_, problem) = scene_problem(&scene)?;
-    let total: usize = solvers
-        .iter()
-        .map(|&s| crate::uniformity::knob_values(s, &problem, points).len())
-        .sum();
-    progress.start(total);
-    let front = design_front(&problem, solvers, points, &|p: &FrontPoint| {
+    let jobs = front_jobs(&problem, solvers, points);
+    let indices = shard.unwrap_or(Shard::WHOLE).points(jobs.len());
+    let mine: Vec<(SolverKind, f64)> = indices.iter().map(|&k| jobs[k]).collect();
+    progress.start(mine.len());
+    let front = design_front_points(&problem, &mine, &|p: &FrontPoint| {
         progress.step(&format!("{:?} knob {:.3e}", p.solver, p.knob));
     });
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    if let Some(shard) = shard {
+        let settings = serde_json::json!({
+            "solvers": solvers.iter().map(study::value_name).collect::<Vec<_>>(),
+            "points": points,
+        });
+        let rows: Vec<(usize, String)> = indices
+            .iter()
+            .zip(&front)
+            .filter_map(|(&k, p)| FrontRow::of(p).map(|r| (k, front_row(&r))))
+            .collect();
+        let path = write_shard(
+            &dir,
+            "front",
+            "front",
+            &scene,
+            shard,
+            jobs.len(),
+            settings,
+            FRONT_COLUMNS,
+            &rows,
+        )?;
+        return Ok((front, vec![path]));
+    }
+    let rows: Vec<FrontRow> = front.iter().filter_map(FrontRow::of).collect();
+    let paths = write_front(&dir, &scene.name, &rows, &front_csv(&rows))?;
+    Ok((front, paths))
+}
+
+/// `front.csv` (the table `csv`), `front.png`, `front.svg` (drawn from `rows`).
+fn write_front(
+    dir: &Path,
+    scene: &str,
+    rows: &[FrontRow],
+    csv: &str,
+) -> Result<Vec<PathBuf>, Error> {
     let paths = [
         dir.join("front.csv"),
         dir.join("front.png"),
         dir.join("front.svg"),
     ];
-    let title = format!(
-        "{}: tension uniformity against surface accuracy",
-        scene.name
-    );
-    front_plot(&front, &title, &paths[1], &paths[2])?;
-    write_atomic(&paths[0], front_csv(&front).as_bytes())?;
-    Ok((front, paths.to_vec()))
+    let title = format!("{scene}: tension uniformity against surface accuracy");
+    front_plot(rows, &title, &paths[1], &paths[2])?;
+    write_atomic(&paths[0], csv.as_bytes())?;
+    Ok(paths.to_vec())
+}
+
+/// Writes a shard's CSV, `<stem>.shard-I-of-N.csv`, in `dir`.
+#[allow(clippy::too_many_arguments)]
+fn write_shard(
+    dir: &Path,
+    stem: &str,
+    command: &str,
+    scene: &Scene,
+    shard: Shard,
+    points: usize,
+    settings: serde_json::Value,
+    columns: &str,
+    rows: &[(usize, String)],
+) -> Result<PathBuf, Error> {
+    let header = ShardHeader {
+        command: command.to_string(),
+        scene: scene.name.clone(),
+        shard,
+        points,
+        settings,
+        scene_file: serde_json::to_value(scene).expect("a scene serialises"),
+    };
+    let path = dir.join(shard.file_name(stem));
+    write_atomic(&path, shard::shard_csv(&header, columns, rows).as_bytes())?;
+    Ok(path)
+}
+
+/// Choices of `ringmesh study`, resolved by the CLI; `None` keeps the
+/// default sweep of [`StudySettings::for_scene`].
+#[derive(Debug, Clone)]
+pub struct StudyOptions {
+    /// The knobs swept (the others are left out).
+    pub knobs: Vec<Knob>,
+    /// Outer-loop tolerances, m.
+    pub tolerances_m: Option<Vec<f64>>,
+    /// Elements per truss rod.
+    pub elements_per_rod: Option<Vec<usize>>,
+    /// Front-net rings.
+    pub rings: Option<Vec<usize>>,
+    /// Truss models.
+    pub truss_models: Option<Vec<TrussModel>>,
+    /// Uniformity solvers.
+    pub solvers: Option<Vec<SolverKind>>,
+    /// Most outer iterations of a run.
+    pub max_iterations: Option<usize>,
+    /// Points run at once (1: one after the other, each timed alone).
+    pub jobs: usize,
+}
+
+impl Default for StudyOptions {
+    fn default() -> Self {
+        StudyOptions {
+            knobs: Knob::SWEPT.to_vec(),
+            tolerances_m: None,
+            elements_per_rod: None,
+            rings: None,
+            truss_models: None,
+            solvers: None,
+            max_iterations: None,
+            jobs: 1,
+        }
+    }
+}
+
+impl StudyOptions {
+    /// The study's settings for `scene`.
+    pub fn settings(&self, scene: &Scene) -> StudySettings {
+        let mut s = StudySettings::for_scene(scene);
+        if let Some(v) = &self.tolerances_m {
+            s.tolerances_m.clone_from(v);
+        }
+        if let Some(v) = &self.elements_per_rod {
+            s.elements_per_rod.clone_from(v);
+        }
+        if let Some(v) = &self.rings {
+            s.rings.clone_from(v);
+        }
+        if let Some(v) = &self.truss_models {
+            s.truss_models.clone_from(v);
+        }
+        if let Some(v) = &self.solvers {
+            s.solvers.clone_from(v);
+        }
+        if let Some(n) = self.max_iterations {
+            s.max_iterations = n;
+        }
+        s.only(&self.knobs)
+    }
+}
+
+/// What `ringmesh study` made.
+#[derive(Debug)]
+pub struct StudyOutcome {
+    /// The scene's name.
+    pub scene: String,
+    /// `(point index, row)` of the points run, in sweep order.
+    pub rows: Vec<(usize, StudyRow)>,
+    /// Points of the whole sweep.
+    pub points: usize,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// The name of the study's table and plots.
+pub const STUDY_STEM: &str = "accuracy-vs-time";
+
+/// `ringmesh study`: what accuracy costs in time ([`crate::study`]). Writes
+/// `accuracy-vs-time.csv`, `.png` and `.svg`; with a `shard`, only that
+/// shard's points (and the reference, run to judge them), written as
+/// `accuracy-vs-time.shard-I-of-N.csv`.
+pub fn study(
+    scene_path: &Path,
+    options: &StudyOptions,
+    output_dir: Option<&Path>,
+    shard: Option<Shard>,
+    progress: &dyn Progress,
+) -> Result<StudyOutcome, Error> {
+    let scene = Scene::read(scene_path)?;
+    let settings = options.settings(&scene);
+    settings.validate()?;
+    let total = study::points(&scene, &settings).len();
+    let part = shard.unwrap_or(Shard::WHOLE);
+    let runs = part.points(total).len() + usize::from(!part.includes(0));
+    progress.start(runs);
+    let rows = study::run_study(&scene, &settings, part, options.jobs, &|r: &StudyRow| {
+        progress.step(&format!("{} {}", r.knob.name(), r.value));
+    })?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let written = match shard {
+        Some(shard) => {
+            let lines: Vec<(usize, String)> =
+                rows.iter().map(|(k, r)| (*k, study_row(r))).collect();
+            let settings = serde_json::to_value(&settings).expect("settings serialise");
+            vec![write_shard(
+                &dir,
+                STUDY_STEM,
+                "study",
+                &scene,
+                shard,
+                total,
+                settings,
+                STUDY_COLUMNS,
+                &lines,
+            )?]
+        }
+        None => {
+            let table: Vec<StudyRow> = rows.iter().map(|(_, r)| r.clone()).collect();
+            write_study(&dir, &scene.name, &table, &study_csv(&table))?
+        }
+    };
+    Ok(StudyOutcome {
+        scene: scene.name,
+        rows,
+        points: total,
+        written,
+    })
+}
+
+/// `accuracy-vs-time.csv` (the table `csv`), `.png`, `.svg` (drawn from `rows`).
+fn write_study(
+    dir: &Path,
+    scene: &str,
+    rows: &[StudyRow],
+    csv: &str,
+) -> Result<Vec<PathBuf>, Error> {
+    let paths = [
+        dir.join(format!("{STUDY_STEM}.csv")),
+        dir.join(format!("{STUDY_STEM}.png")),
+        dir.join(format!("{STUDY_STEM}.svg")),
+    ];
+    let title =
+        format!("{scene}: what accuracy costs in time (designs as built on the reference truss)");
+    study_plot(rows, &title, &paths[1], &paths[2])?;
+    write_atomic(&paths[0], csv.as_bytes())?;
+    Ok(paths.to_vec())
+}
+
+/// One sweep joined by `ringmesh merge`.
+#[derive(Debug)]
+pub struct MergeOutcome {
+    /// The command whose shards were joined (`front`, `study`).
+    pub command: String,
+    /// The scene's name.
+    pub scene: String,
+    /// Shards joined.
+    pub shards: usize,
+    /// Rows of the merged table.
+    pub rows: usize,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// `ringmesh merge`: joins the shard CSVs among `paths` (files, or folders
+/// holding `*.shard-I-of-N.csv`) into each sweep's table and plots, exactly
+/// as the unsharded run writes them, in `output_dir` (default
+/// `results/<scene>/`). Shards of different scenes or settings, duplicate or
+/// missing shards are refused before anything is written.
+pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOutcome>, Error> {
+    let files = shard::find_shards(paths)?
+        .iter()
+        .map(|p| shard::read_shard(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let merged = shard::merge(files)?;
+    // Parse every table before writing any.
+    enum Table {
+        Front(Vec<FrontRow>),
+        Study(Vec<StudyRow>),
+    }
+    let mut tables = Vec::new();
+    for m in &merged {
+        let bad = |reason: String| ShardError::Format {
+            path: m.files[0].clone(),
+            reason,
+        };
+        let table = match m.header.command.as_str() {
+            "front" => Table::Front(
+                m.rows
+                    .iter()
+                    .map(|l| parse_front_row(l).map_err(&bad))
+                    .collect::<Result<_, _>>()?,
+            ),
+            "study" => Table::Study(
+                m.rows
+                    .iter()
+                    .map(|l| parse_study_row(l).map_err(&bad))
+                    .collect::<Result<_, _>>()?,
+            ),
+            other => return Err(bad(format!("unknown command `{other}`")).into()),
+        };
+        tables.push(table);
+    }
+    let mut outcomes = Vec::new();
+    for (m, table) in merged.iter().zip(tables) {
+        let dir = output_dir.map_or_else(
+            || Path::new("results").join(&m.header.scene),
+            Path::to_path_buf,
+        );
+        // The plots are drawn from the parsed rows; the table is the shards' text.
+        let written = match table {
+            Table::Front(rows) => write_front(&dir, &m.header.scene, &rows, &m.csv())?,
+            Table::Study(rows) => write_study(&dir, &m.header.scene, &rows, &m.csv())?,
+        };
+        outcomes.push(MergeOutcome {
+            command: m.header.command.clone(),
+            scene: m.header.scene.clone(),
+            shards: m.files.len(),
+            rows: m.rows.len(),
+            written,
+        });
+    }
+    Ok(outcomes)
 }
 
 /// One node of `ringmesh frame`'s output.
@@ -650,8 +986,8 @@ pub fn design(
     let clock = std::time::Instant::now();
     let scene = Scene::read(scene_path)?;
     let model = options.truss.unwrap_or(scene.effects.truss);
-    let (mesh, problem) = scene_problem(&scene)?;
-    let nets = TiedNets::new(&mesh, problem)?.with_cable_self_weight(CableSelfWeight::of(&scene));
+    let scene_nets = SceneNets::new(&scene)?;
+    let (mesh, nets) = (&scene_nets.mesh, &scene_nets.nets);
     let solver = options.solver.build(None);
     let relaxations = if options.relaxations.is_empty() {
         vec![Relaxation::default()]
@@ -667,18 +1003,11 @@ pub fn design(
             max_iterations: options.max_iterations,
             ..LoopSettings::default()
         };
-        let mut oracle = crate::truss::oracle(model, &scene, &mesh.truss)?;
         let mut history = Vec::new();
-        let result = design_loop(
-            &nets,
-            solver.as_ref(),
-            oracle.as_mut(),
-            &settings,
-            &mut |r| {
-                history.push(r.clone());
-                observe(relaxation, r)
-            },
-        );
+        let result = scene_nets.design_loop(&scene, solver.as_ref(), model, &settings, &mut |r| {
+            history.push(r.clone());
+            observe(relaxation, r)
+        });
         match result {
             Ok(result) => {
                 runs.push(LoopRun {
@@ -705,19 +1034,19 @@ pub fn design(
             // No truss equilibrium: say how far below the pull the truss's
             // stability ends (the rigid-truss design's pull, the loop's first).
             Err(
-                e @ DesignError::Truss {
+                e @ Error::Design(DesignError::Truss {
                     source: TrussError::NoEquilibrium { .. },
                     ..
-                },
+                }),
             ) => {
                 let first =
                     nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
-                return Err(match design_margin(&scene, &mesh, &first.design) {
+                return Err(match design_margin(&scene, mesh, &first.design) {
                     Err(past) => past,
-                    Ok(_) => e.into(),
+                    Ok(_) => e,
                 });
             }
-            Err(e) => return Err(e.into()),
+            Err(e) => return Err(e),
         }
     }
     let outcome = outcome.expect("at least one relaxation");
@@ -728,17 +1057,17 @@ pub fn design(
     };
     let limit_margin = match assembly {
         AssemblyTruss::Rigid => None,
-        AssemblyTruss::Flexible => Some(design_margin(&scene, &mesh, &outcome.design)?),
+        AssemblyTruss::Flexible => Some(design_margin(&scene, mesh, &outcome.design)?),
     };
     let network = outcome.problem.network();
-    let verification = verify(&scene, &mesh, network, &outcome.design, assembly)?;
+    let verification = verify(&scene, mesh, network, &outcome.design, assembly)?;
     let conventional = match assembly {
         AssemblyTruss::Rigid => None,
         AssemblyTruss::Flexible => {
             let rigid = nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
             Some(verify(
                 &scene,
-                &mesh,
+                mesh,
                 rigid.problem.network(),
                 &rigid.design,
                 AssemblyTruss::Flexible,
@@ -765,7 +1094,7 @@ pub fn design(
         net: outcome.design.clone(),
     };
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
-    let written = write_design(&dir, &scene, &mesh, network, &report)?;
+    let written = write_design(&dir, &scene, mesh, network, &report)?;
     Ok(DesignOutcome { report, written })
 }
 

@@ -156,7 +156,7 @@ pub struct IterationRecord {
 }
 
 /// How the loop ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LoopTermination {
     /// `‖G(C_k) − C_k‖∞ ≤ tol`.

@@ -48,6 +48,9 @@ pub struct ReflectorMesh {
     pub truss: RingTrussLayout,
     /// Rings of the sector subdivision.
     pub rings: usize,
+    /// The front net's facets: triangles of front-net nodes, counter-clockwise
+    /// in plan.
+    pub front_triangles: Vec<[usize; 3]>,
     /// Inward sag of the free boundary, as a fraction of the bay chord.
     pub boundary_sag_ratio: f64,
 }
@@ -315,6 +318,7 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
         aperture,
         truss,
         rings,
+        front_triangles: grid.triangles,
         boundary_sag_ratio: scene.front_net.boundary_sag_ratio,
     })
 }

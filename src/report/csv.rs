@@ -1,10 +1,13 @@
-//! CSV tables: the cable table a manufacturer needs, and the design front.
+//! CSV tables: the cable table a manufacturer needs, the design front and the
+//! accuracy study — and the rows of the last two read back, for `merge`.
 
 use std::fmt::Write;
 
+use crate::design::LoopTermination;
 use crate::network::Network;
-use crate::scene::Cables;
-use crate::uniformity::{Design, FrontPoint};
+use crate::scene::{Cables, TrussModel};
+use crate::study::{value_name, Knob, RunSettings, StudyRow};
+use crate::uniformity::{Design, FrontPoint, SolverKind};
 
 /// `id,group,i,j,q,tension_n,length_m,cut_length_m`: one row per cable, with the
 /// unstressed cut length `L0 = ℓ/(1 + T/EA)` (DESIGN §7).
@@ -34,18 +37,295 @@ pub fn cables_csv(network: &Network, design: &Design, cables: &Cables) -> String
     s
 }
 
-/// `solver,knob,ratio,rms_mm,time_s`: the successful points of a design front.
-pub fn front_csv(points: &[FrontPoint]) -> String {
-    let mut s = String::from("solver,knob,ratio,rms_mm,time_s\n");
-    for p in points.iter().filter(|p| p.outcome.is_ok()) {
-        let name = clap::ValueEnum::to_possible_value(&p.solver)
-            .map(|v| v.get_name().to_string())
-            .unwrap_or_default();
-        let _ = writeln!(
-            s,
-            "{name},{:e},{:.10e},{:.6e},{:.6e}",
-            p.knob, p.ratio, p.rms_mm, p.time_s
-        );
+/// One row of `front.csv`: a successful design of the front.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrontRow {
+    /// The solver's command-line name.
+    pub solver: String,
+    /// Its accuracy knob.
+    pub knob: f64,
+    /// `Tmax/Tmin` over the uniformity sets (the largest).
+    pub ratio: f64,
+    /// RMS surface error of the forward solve, mm.
+    pub rms_mm: f64,
+    /// Wall time of the solve, s.
+    pub time_s: f64,
+}
+
+impl FrontRow {
+    /// The row of a point of the front; `None` for a failed point.
+    pub fn of(point: &FrontPoint) -> Option<FrontRow> {
+        point.outcome.is_ok().then(|| FrontRow {
+            solver: value_name(&point.solver),
+            knob: point.knob,
+            ratio: point.ratio,
+            rms_mm: point.rms_mm,
+            time_s: point.time_s,
+        })
+    }
+}
+
+/// The columns of `front.csv`.
+pub const FRONT_COLUMNS: &str = "solver,knob,ratio,rms_mm,time_s";
+
+/// One line of `front.csv` (without its newline).
+pub fn front_row(row: &FrontRow) -> String {
+    format!(
+        "{},{:e},{:.10e},{:.6e},{:.6e}",
+        row.solver, row.knob, row.ratio, row.rms_mm, row.time_s
+    )
+}
+
+/// `solver,knob,ratio,rms_mm,time_s`: the design front, one row per
+/// successful point.
+pub fn front_csv(rows: &[FrontRow]) -> String {
+    table(FRONT_COLUMNS, rows.iter().map(front_row))
+}
+
+/// Reads a line of `front.csv` back.
+///
+/// # Errors
+/// A line that is not one, with the reason.
+pub fn parse_front_row(line: &str) -> Result<FrontRow, String> {
+    let f = split_row(line, 5)?;
+    Ok(FrontRow {
+        solver: f[0].clone(),
+        knob: number(&f[1], "knob")?,
+        ratio: number(&f[2], "ratio")?,
+        rms_mm: number(&f[3], "rms_mm")?,
+        time_s: number(&f[4], "time_s")?,
+    })
+}
+
+/// The columns of `accuracy-vs-time.csv`.
+pub const STUDY_COLUMNS: &str = "knob,value,tolerance_m,elements_per_rod,rings,truss,solver,\
+    time_s,outer_iterations,termination,boundary_residual_m,ratio,built_ratio,ratio_error,\
+    rms_mm,max_deviation_mm,facet_rms_mm,tension_change_pct,cut_length_error_mm,error";
+
+/// One line of `accuracy-vs-time.csv` (without its newline); missing numbers
+/// are empty.
+pub fn study_row(r: &StudyRow) -> String {
+    let g = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.6e}")
+        } else {
+            String::new()
+        }
+    };
+    let s = &r.settings;
+    format!(
+        "{},{},{:e},{},{},{},{},{:.4e},{},{},{},{},{},{},{},{},{},{},{},{}",
+        r.knob.name(),
+        r.value,
+        s.tolerance_m,
+        s.elements_per_rod,
+        s.rings,
+        value_name(&s.truss),
+        value_name(&s.solver),
+        r.time_s,
+        r.outer_iterations.map_or(String::new(), |n| n.to_string()),
+        r.termination.map_or(String::new(), termination_name),
+        g(r.boundary_residual_m),
+        if r.ratio.is_finite() {
+            format!("{:.10e}", r.ratio)
+        } else {
+            String::new()
+        },
+        if r.built_ratio.is_finite() {
+            format!("{:.10e}", r.built_ratio)
+        } else {
+            String::new()
+        },
+        g(r.ratio_error),
+        g(r.rms_mm),
+        g(r.max_deviation_mm),
+        g(r.facet_rms_mm),
+        g(r.tension_change_pct),
+        g(r.cut_length_error_mm),
+        r.error.as_deref().map_or(String::new(), quote),
+    )
+}
+
+fn termination_name(t: LoopTermination) -> String {
+    serde_json::to_value(t)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default()
+}
+
+/// The accuracy study, one row per point, in sweep order.
+pub fn study_csv(rows: &[StudyRow]) -> String {
+    table(STUDY_COLUMNS, rows.iter().map(study_row))
+}
+
+/// Reads a line of `accuracy-vs-time.csv` back.
+///
+/// # Errors
+/// A line that is not one, with the reason.
+pub fn parse_study_row(line: &str) -> Result<StudyRow, String> {
+    let f = split_row(line, 20)?;
+    let optional = |text: &str, name: &str| -> Result<f64, String> {
+        if text.is_empty() {
+            Ok(f64::NAN)
+        } else {
+            number(text, name)
+        }
+    };
+    let truss = <TrussModel as clap::ValueEnum>::from_str(&f[5], false)
+        .map_err(|_| format!("unknown truss model {:?}", f[5]))?;
+    let solver = <SolverKind as clap::ValueEnum>::from_str(&f[6], false)
+        .map_err(|_| format!("unknown solver {:?}", f[6]))?;
+    let termination = if f[9].is_empty() {
+        None
+    } else {
+        Some(
+            serde_json::from_value(serde_json::Value::String(f[9].clone()))
+                .map_err(|_| format!("unknown termination {:?}", f[9]))?,
+        )
+    };
+    Ok(StudyRow {
+        knob: Knob::from_name(&f[0]).ok_or_else(|| format!("unknown knob {:?}", f[0]))?,
+        value: f[1].clone(),
+        settings: RunSettings {
+            tolerance_m: number(&f[2], "tolerance_m")?,
+            elements_per_rod: whole(&f[3], "elements_per_rod")?,
+            rings: whole(&f[4], "rings")?,
+            truss,
+            solver,
+        },
+        time_s: number(&f[7], "time_s")?,
+        outer_iterations: if f[8].is_empty() {
+            None
+        } else {
+            Some(whole(&f[8], "outer_iterations")?)
+        },
+        termination,
+        boundary_residual_m: optional(&f[10], "boundary_residual_m")?,
+        ratio: optional(&f[11], "ratio")?,
+        built_ratio: optional(&f[12], "built_ratio")?,
+        ratio_error: optional(&f[13], "ratio_error")?,
+        rms_mm: optional(&f[14], "rms_mm")?,
+        max_deviation_mm: optional(&f[15], "max_deviation_mm")?,
+        facet_rms_mm: optional(&f[16], "facet_rms_mm")?,
+        tension_change_pct: optional(&f[17], "tension_change_pct")?,
+        cut_length_error_mm: optional(&f[18], "cut_length_error_mm")?,
+        error: (!f[19].is_empty()).then(|| f[19].clone()),
+    })
+}
+
+/// A column line and rows, each ended by a newline.
+fn table(columns: &str, rows: impl Iterator<Item = String>) -> String {
+    let mut s = format!("{columns}\n");
+    for row in rows {
+        s.push_str(&row);
+        s.push('\n');
     }
     s
+}
+
+/// A text field: quoted when it holds a comma or a quote (quotes doubled);
+/// line breaks become spaces, so a row stays on one line.
+fn quote(text: &str) -> String {
+    let text = text.replace(['\n', '\r'], " ");
+    if text.contains([',', '"']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text
+    }
+}
+
+/// The fields of a CSV line (quoted fields unquoted), exactly `n` of them.
+fn split_row(line: &str, n: usize) -> Result<Vec<String>, String> {
+    let mut fields = Vec::with_capacity(n);
+    let mut field = String::new();
+    let mut chars = line.chars().peekable();
+    let mut quoted = false;
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (true, '"') if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            (true, '"') => quoted = false,
+            (false, '"') if field.is_empty() => quoted = true,
+            (false, ',') => fields.push(std::mem::take(&mut field)),
+            (_, c) => field.push(c),
+        }
+    }
+    fields.push(field);
+    if fields.len() == n {
+        Ok(fields)
+    } else {
+        Err(format!("{} fields, {n} expected", fields.len()))
+    }
+}
+
+fn number(text: &str, name: &str) -> Result<f64, String> {
+    text.parse()
+        .map_err(|_| format!("{name}: {text:?} is not a number"))
+}
+
+fn whole(text: &str, name: &str) -> Result<usize, String> {
+    text.parse()
+        .map_err(|_| format!("{name}: {text:?} is not a whole number"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn study_rows_read_back_as_written() {
+        let row = StudyRow {
+            knob: Knob::Solver,
+            value: "least-squares".into(),
+            settings: RunSettings {
+                tolerance_m: 1e-6,
+                elements_per_rod: 4,
+                rings: 3,
+                truss: TrussModel::Exact,
+                solver: SolverKind::LeastSquares,
+            },
+            time_s: 0.25,
+            outer_iterations: Some(4),
+            termination: Some(LoopTermination::MaxIterations),
+            boundary_residual_m: 2.5e-8,
+            ratio: 1.25,
+            built_ratio: 1.5,
+            ratio_error: 0.125,
+            rms_mm: 1e-6,
+            max_deviation_mm: 2e-6,
+            facet_rms_mm: 3.0,
+            tension_change_pct: 0.5,
+            cut_length_error_mm: f64::NAN,
+            error: Some("outer iteration 2: a \"quoted\", comma\nand a line".into()),
+        };
+        let line = study_row(&row);
+        assert!(!line.contains('\n'));
+        let back = parse_study_row(&line).unwrap();
+        assert_eq!(study_row(&back), line);
+        assert_eq!(back.knob, Knob::Solver);
+        assert_eq!(back.settings, row.settings);
+        assert_eq!(back.termination, row.termination);
+        assert!(back.cut_length_error_mm.is_nan());
+        assert_eq!(
+            back.error.as_deref(),
+            Some("outer iteration 2: a \"quoted\", comma and a line")
+        );
+        assert_eq!(STUDY_COLUMNS.split(',').count(), 20);
+    }
+
+    #[test]
+    fn front_rows_read_back_as_written() {
+        let row = FrontRow {
+            solver: "bisection".into(),
+            knob: 0.07,
+            ratio: 1.2345678901234,
+            rms_mm: 1.5e-3,
+            time_s: 0.01,
+        };
+        let line = front_row(&row);
+        assert_eq!(front_row(&parse_front_row(&line).unwrap()), line);
+        assert!(parse_front_row("bisection,1,2").is_err());
+    }
 }

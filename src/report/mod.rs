@@ -1,4 +1,4 @@
-//! Files a run writes: JSON, VTK. Every file is written to a temporary file in
+//! Files a run writes: JSON, CSV, VTK, plots. Every file is written to a temporary file in
 //! the target folder and renamed into place, so a reader never sees half a file
 //! and an interrupted run leaves earlier results intact.
 
@@ -11,8 +11,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-pub use csv::{cables_csv, front_csv};
-pub use plot::{convergence_plot, front_plot, surface_plot};
+pub use csv::{
+    cables_csv, front_csv, front_row, parse_front_row, parse_study_row, study_csv, study_row,
+    FrontRow, FRONT_COLUMNS, STUDY_COLUMNS,
+};
+pub use plot::{convergence_plot, front_plot, study_plot, surface_plot};
 pub use vtk::{assembly_vtu, network_vtu};
 
 /// Writing a result failed.

@@ -57,23 +57,42 @@ pub fn knob_values(solver: SolverKind, problem: &UniformityProblem, points: usiz
     }
 }
 
-/// Sweeps the knob of every solver in `solvers` over `points` values, in
-/// parallel; `on_point` is called as each point finishes (from worker threads).
-/// Points come back in the deterministic order solver-major, knob ascending.
-pub fn design_front(
+/// The front's points, `(solver, knob)`, in the deterministic order
+/// solver-major (as listed), knob ascending ([`knob_values`]).
+pub fn front_jobs(
     problem: &UniformityProblem,
     solvers: &[SolverKind],
     points: usize,
-    on_point: &(dyn Fn(&FrontPoint) + Sync),
-) -> Vec<FrontPoint> {
-    let jobs: Vec<(SolverKind, f64)> = solvers
+) -> Vec<(SolverKind, f64)> {
+    solvers
         .iter()
         .flat_map(|&s| {
             knob_values(s, problem, points)
                 .into_iter()
                 .map(move |k| (s, k))
         })
-        .collect();
+        .collect()
+}
+
+/// Sweeps the knob of every solver in `solvers` over `points` values, in
+/// parallel; `on_point` is called as each point finishes (from worker threads).
+/// Points come back in the order of [`front_jobs`].
+pub fn design_front(
+    problem: &UniformityProblem,
+    solvers: &[SolverKind],
+    points: usize,
+    on_point: &(dyn Fn(&FrontPoint) + Sync),
+) -> Vec<FrontPoint> {
+    design_front_points(problem, &front_jobs(problem, solvers, points), on_point)
+}
+
+/// Designs the front's points `jobs` in parallel, returned in their order;
+/// `on_point` is called as each finishes (from worker threads).
+pub fn design_front_points(
+    problem: &UniformityProblem,
+    jobs: &[(SolverKind, f64)],
+    on_point: &(dyn Fn(&FrontPoint) + Sync),
+) -> Vec<FrontPoint> {
     jobs.par_iter()
         .map(|&(solver, knob)| {
             let start = Instant::now();

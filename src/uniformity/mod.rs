@@ -22,7 +22,7 @@ mod selection;
 
 pub use bisection::Bisection;
 pub use design::{Design, TensionSpread, Termination};
-pub use front::{design_front, knob_values, FrontPoint};
+pub use front::{design_front, design_front_points, front_jobs, knob_values, FrontPoint};
 pub use gradient::{Gradient, History};
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
