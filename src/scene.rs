@@ -207,6 +207,10 @@ pub struct Effects {
     /// [`Scene::read`] / [`Scene::from_toml_in`] (only when the key is given).
     #[serde(skip)]
     pub rod_properties: Option<crate::truss::RodProperties>,
+    /// Whether verification assembles elastic cables (`true`, the default:
+    /// EA of `[cables]`, cut to `L₀ = ℓ/(1 + T/EA)`) or inextensible ones
+    /// (`false`; see [`crate::verify::CableModel`]).
+    pub cable_elasticity: bool,
 }
 
 impl Default for Effects {
@@ -215,6 +219,7 @@ impl Default for Effects {
             truss: TrussModel::default(),
             rod_properties_csv: None,
             rod_properties: None,
+            cable_elasticity: true,
         }
     }
 }
