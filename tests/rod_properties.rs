@@ -103,8 +103,9 @@ fn scaled(loads: &[[f64; 3]], s: f64) -> Vec<[f64; 3]> {
 /// scaling maps the equilibrium equations `f_int(u; 2C) = 2 f_int(u; C) = P`
 /// onto the nominal truss under `P/2`: the stiffer truss under the pull
 /// stands where the nominal one stands under half the pull, to the
-/// solver's tolerance — and, geometric nonlinearity aside, at about half
-/// the displacement.
+/// solver's tolerance (measured: to the bit, ×2 being exact in binary
+/// floating point) — and, geometric nonlinearity aside, at about half the
+/// displacement (measured ×0.50072).
 #[test]
 fn every_rod_twice_as_stiff_halves_the_linear_displacement_and_is_the_exact_truss_at_half_load() {
     let scene = small_hex();
@@ -358,4 +359,76 @@ fn scene_reads_its_table_beside_it_and_refuses_bad_ones() {
     fewer.truss.bays = 4;
     let e = fewer.validate().unwrap_err();
     assert!(e.to_string().contains("`top longeron 4`"), "{e}");
+}
+
+fn ringmesh_truss(scene: &Path, out: &Path) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(["truss", "--model", "linear", "-o"])
+        .arg(out)
+        .arg(scene)
+        .output()
+        .expect("run ringmesh")
+}
+
+fn max_displacement_m(json: &Path) -> f64 {
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(json).unwrap()).unwrap();
+    v["max_displacement_m"].as_f64().unwrap()
+}
+
+/// The command line reads the table beside the scene: `ringmesh truss` with
+/// bottom longerons of half the EA moves the hinges twice as far as the
+/// nominal truss; a bad table exits with code 2, names file, line, rod and
+/// column, and writes nothing.
+#[test]
+fn truss_command_applies_the_table_and_refuses_a_bad_one() {
+    let dir = scratch("cli");
+    let nominal_json = dir.join("nominal.json");
+    let run = ringmesh_truss(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml"),
+        &nominal_json,
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let half = 0.5 * nominal(&small_hex()).axial_n;
+    let rows: String = (0..6)
+        .map(|k| format!("bottom longeron {k},{half:e}\n"))
+        .collect();
+    std::fs::write(
+        dir.join("rods.csv"),
+        format!("rod,axial_stiffness_n\n{rows}"),
+    )
+    .unwrap();
+    let soft_json = dir.join("soft.json");
+    let run = ringmesh_truss(&write_scene(&dir, "rods.csv"), &soft_json);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let ratio = max_displacement_m(&soft_json) / max_displacement_m(&nominal_json);
+    assert!((1.9..=2.0).contains(&ratio), "displacement ×{ratio}");
+
+    std::fs::write(
+        dir.join("bad.csv"),
+        "rod,axial_stiffness_n\nbatten 2,-5e7\n",
+    )
+    .unwrap();
+    let bad_json = dir.join("bad.json");
+    let run = ringmesh_truss(&write_scene(&dir, "bad.csv"), &bad_json);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    for w in [
+        "effects.rod_properties_csv",
+        "bad.csv",
+        "line 2",
+        "`batten 2`",
+        "axial_stiffness_n",
+        "`-5e7`",
+    ] {
+        assert!(stderr.contains(w), "{stderr} lacks {w}");
+    }
+    assert!(!bad_json.exists());
 }

@@ -409,7 +409,7 @@ impl RodProperties {
                     .parse()
                     .map_err(|_| value_error(format!("`{cell}` is not a number")))?;
                 if !(value.is_finite() && value > 0.0) {
-                    return Err(value_error(format!("{value} must be a finite number > 0")));
+                    return Err(value_error(format!("`{cell}` must be a finite number > 0")));
                 }
                 *stiffness.slot(column) = Some(value);
             }
