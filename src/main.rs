@@ -362,7 +362,8 @@ fn main() -> ExitCode {
                 );
                 let v = &r.verification;
                 say!(
-                    "assembled: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, boundary {:.3e} mm, {} slack cables",
+                    "assembled{}: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, boundary {:.3e} mm, {} slack cables",
+                    cables_note(v),
                     v.rms_mm,
                     v.max_deviation_mm,
                     v.max_tension_change_pct,
@@ -371,7 +372,8 @@ fn main() -> ExitCode {
                 );
                 if let Some(c) = &r.conventional {
                     say!(
-                        "conventional (rigid-truss) design assembled: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, {} slack cables",
+                        "conventional (rigid-truss) design assembled{}: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, {} slack cables",
+                        cables_note(c),
                         c.rms_mm,
                         c.max_deviation_mm,
                         c.max_tension_change_pct,
@@ -717,5 +719,14 @@ fn print_cantilever(t: &CantileverTable) {
             1e3 * row.time_s,
             if row.converged { "" } else { "  NOT CONVERGED" }
         );
+    }
+}
+
+/// How the assembly's cables were modelled, when not as built (`[effects]
+/// cable_elasticity = false`).
+fn cables_note(v: &ringmesh::verify::Verification) -> &'static str {
+    match v.cable_model {
+        ringmesh::verify::CableModel::Elastic => "",
+        ringmesh::verify::CableModel::Inextensible => " with inextensible cables",
     }
 }

@@ -208,13 +208,39 @@ pub enum TrussModel {
 }
 
 /// The physics a scene asks for (DESIGN §8); what is not asked for is not built.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Effects {
     /// The truss model of the design loop.
     pub truss: TrussModel,
     /// Self weight of cables, rods and hinges (a ground test); absent: orbit.
     pub gravity: Option<Gravity>,
+    /// Measured rod properties: a CSV table of EA/EI (GJ, GA) per rod that
+    /// overrides the nominal tube section of the rods it names, relative to
+    /// the scene file's folder (format and rod names:
+    /// [`crate::truss::RodProperties`]). Absent: every rod is the nominal tube.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rod_properties_csv: Option<std::path::PathBuf>,
+    /// The table of `rod_properties_csv`, read and validated by
+    /// [`Scene::read`] / [`Scene::from_toml_in`] (only when the key is given).
+    #[serde(skip)]
+    pub rod_properties: Option<crate::truss::RodProperties>,
+    /// Whether verification assembles elastic cables (`true`, the default:
+    /// EA of `[cables]`, cut to `L₀ = ℓ/(1 + T/EA)`) or inextensible ones
+    /// (`false`; see [`crate::verify::CableModel`]).
+    pub cable_elasticity: bool,
+}
+
+impl Default for Effects {
+    fn default() -> Self {
+        Effects {
+            truss: TrussModel::default(),
+            gravity: None,
+            rod_properties_csv: None,
+            rod_properties: None,
+            cable_elasticity: true,
+        }
+    }
 }
 
 /// Gravity: the self weight of the cables (nodal loads of the force density
@@ -259,6 +285,10 @@ pub enum SceneError {
         /// The parser's message.
         message: String,
     },
+    /// The table of `effects.rod_properties_csv` cannot be read or is
+    /// invalid; the message names the file, the line and the rod or column.
+    #[error("`effects.rod_properties_csv`: {0}")]
+    RodProperties(#[from] crate::truss::RodPropertiesError),
     /// A value is out of its valid range.
     #[error("`{key}`: {reason}")]
     Invalid {
@@ -274,6 +304,7 @@ impl SceneError {
     pub fn key(&self) -> Option<&'static str> {
         match self {
             SceneError::Invalid { key, .. } => Some(key),
+            SceneError::RodProperties(_) => Some("effects.rod_properties_csv"),
             _ => None,
         }
     }
@@ -287,7 +318,9 @@ impl SceneError {
 }
 
 impl Scene {
-    /// Reads, parses and validates a scene file; the name defaults to the file stem.
+    /// Reads, parses and validates a scene file; the name defaults to the file
+    /// stem, and files the scene names (`effects.rod_properties_csv`) are
+    /// relative to the scene file's folder.
     pub fn read(path: &Path) -> Result<Scene, SceneError> {
         let shown = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
@@ -298,7 +331,8 @@ impl Scene {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        Scene::from_toml(&text, &stem).map_err(|e| match e {
+        let folder = path.parent().unwrap_or(Path::new(""));
+        Scene::from_toml_in(&text, &stem, folder).map_err(|e| match e {
             SceneError::Parse { message, .. } => SceneError::Parse {
                 path: shown,
                 message,
@@ -307,8 +341,18 @@ impl Scene {
         })
     }
 
-    /// Parses and validates scene text; `default_name` is used when it has no `name`.
+    /// Parses and validates scene text; `default_name` is used when it has no
+    /// `name`. Files the scene names are relative to the current directory.
     pub fn from_toml(text: &str, default_name: &str) -> Result<Scene, SceneError> {
+        Scene::from_toml_in(text, default_name, Path::new(""))
+    }
+
+    /// [`Scene::from_toml`] with the files the scene names relative to `folder`.
+    pub fn from_toml_in(
+        text: &str,
+        default_name: &str,
+        folder: &Path,
+    ) -> Result<Scene, SceneError> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
             path: "<scene>".into(),
             message: e.to_string(),
@@ -317,7 +361,17 @@ impl Scene {
             scene.name = default_name.to_string();
         }
         scene.validate()?;
+        scene.read_effect_files(folder)?;
         Ok(scene)
+    }
+
+    /// Reads the tables the effects name (only those asked for).
+    fn read_effect_files(&mut self, folder: &Path) -> Result<(), SceneError> {
+        if let Some(file) = &self.effects.rod_properties_csv {
+            let table = crate::truss::RodProperties::read(&folder.join(file), self.truss.bays)?;
+            self.effects.rod_properties = Some(table);
+        }
+        Ok(())
     }
 
     /// Checks every value against its valid range.
@@ -427,6 +481,21 @@ impl Scene {
                 "uniformity.min_tension_fraction",
                 format!("{} must lie in (0, 1)", u.min_tension_fraction),
             ));
+        }
+
+        if self
+            .effects
+            .rod_properties_csv
+            .as_ref()
+            .is_some_and(|f| f.as_os_str().is_empty())
+        {
+            return Err(SceneError::invalid(
+                "effects.rod_properties_csv",
+                "must name a CSV file (relative to the scene's folder)",
+            ));
+        }
+        if let Some(table) = &self.effects.rod_properties {
+            table.check_bays(t.bays)?;
         }
 
         let c = &self.cables;

@@ -485,7 +485,7 @@ mod tests {
 
     fn write(dir: &Path, h: &ShardHeader, rows: &[(usize, String)]) -> PathBuf {
         let path = dir.join(h.shard.file_name("front"));
-        std::fs::write(&path, shard_csv(h, "a,b", rows)).unwrap();
+        crate::report::write_atomic(&path, shard_csv(h, "a,b", rows).as_bytes()).unwrap();
         path
     }
 

@@ -8,6 +8,15 @@
 //! is either rigid (the attachment points held where the layout puts them)
 //! or the flexible ring truss of the scene (geometrically exact beams, hinges
 //! and joints, isostatic support).
+//!
+//! `[effects] cable_elasticity = false` assembles inextensible cables instead
+//! (design lengths, by a penalty stiffness): [`CableModel`], whose module
+//! documents the model and its stiffening factor. [`Verification::cable_model`]
+//! says which model an assembly used.
+
+mod cable_model;
+
+pub use cable_model::{CableModel, INEXTENSIBLE_STIFFENING};
 
 use std::time::Instant;
 
@@ -15,7 +24,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::geometry::ReflectorMesh;
-use crate::mechanics::State;
+use crate::mechanics::{constraint_scale, State};
 use crate::mechanics::{
     MechanicsError, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver, StaticTermination,
 };
@@ -54,6 +63,21 @@ pub enum VerifyError {
         /// The largest prestrain factor reached.
         load_factor: f64,
     },
+    /// The inextensible assembly lost its equilibrium while its cables were
+    /// stiffened from the elastic one ([`CableModel::Inextensible`]).
+    #[error(
+        "the assembled net and truss found no equilibrium with cables {stiffening:e} × stiffer \
+         than the scene's on the way to inextensible ones ({termination:?}, last converged \
+         prestrain factor {load_factor:.4} of that stage)"
+    )]
+    NoInextensibleEquilibrium {
+        /// The stiffening `EA*/EA` of the stage that failed.
+        stiffening: f64,
+        /// How the stage's static solve ended.
+        termination: StaticTermination,
+        /// The largest prestrain factor reached in that stage.
+        load_factor: f64,
+    },
 }
 
 /// The assembled equilibrium, judged against the design.
@@ -61,6 +85,11 @@ pub enum VerifyError {
 pub struct Verification {
     /// The truss the cables were assembled on.
     pub truss: AssemblyTruss,
+    /// The cables assembled: elastic or inextensible (`[effects] cable_elasticity`).
+    pub cable_model: CableModel,
+    /// Axial stiffness of every assembled cable, N (the penalty's for
+    /// inextensible cables).
+    pub cable_axial_stiffness_n: f64,
     /// RMS axial deviation of the front net's free nodes from the paraboloid, mm.
     pub rms_mm: f64,
     /// Largest axial deviation of a front-net free node from the paraboloid, mm.
@@ -74,9 +103,10 @@ pub struct Verification {
     pub max_node_shift_mm: f64,
     /// Cables not longer than their cut length at equilibrium.
     pub slack_cables: Vec<usize>,
-    /// Newton iterations of the assembly solve.
+    /// Newton iterations of the assembly solve (every stage's, for
+    /// inextensible cables).
     pub newton_iterations: usize,
-    /// Load (prestrain) steps.
+    /// Load (prestrain) steps (every stage's, for inextensible cables).
     pub load_steps: usize,
     /// Wall time of building and solving the assembly, s.
     pub time_s: f64,
@@ -187,6 +217,8 @@ pub fn verify(
             b.add_load(node_of[i], vector(p), nalgebra::Vector3::zeros());
         }
     }
+    // The truss and the net's points, for the inextensible cables' stages.
+    let bare = b.clone();
     let ea = scene.cables.axial_stiffness_n();
     let mut ramped = b.clone();
     for (k, &[i, j]) in network.edges.iter().enumerate() {
@@ -210,11 +242,12 @@ pub fn verify(
     // motion being many times the cables' elastic stretch); then, if that
     // fails, from the undeformed truss with the prestrain ramped in load steps.
     let mut found = None;
-    if let Some(guess) = truss_guess(scene, mesh, design, truss)? {
+    if let Some((guess, guess_scale)) = truss_guess(scene, mesh, design, truss)? {
         let solver = StaticSolver::new(b.build()?)?;
         let mut start = solver.reference_state();
         start.frames[..guess.frames.len()].copy_from_slice(&guess.frames);
         start.set_multipliers(&guess);
+        start.rescale_multipliers(guess_scale / constraint_scale(solver.model()));
         // One Newton solve, no step cuts: from a good guess it converges at
         // once; otherwise the ramp below is the better path.
         let once = StaticSettings {
@@ -240,6 +273,24 @@ pub fn verify(
             load_factor: solution.load_factor,
         });
     }
+    // Inextensible cables: the elastic equilibrium stiffened in stages.
+    let cable_model = CableModel::of(scene);
+    let (solver, solution, newton_iterations, load_steps) = match cable_model {
+        CableModel::Elastic => {
+            let (n, s) = (solution.newton_iterations, solution.steps.len());
+            (solver, solution, n, s)
+        }
+        CableModel::Inextensible => {
+            let targets: Vec<[f64; 2]> = network
+                .edges
+                .iter()
+                .enumerate()
+                .map(|(k, _)| [design.lengths_m[k], design.tensions_n[k]])
+                .collect();
+            cable_model::stiffen(&bare, &targets, ea, solver, solution, &settings)?
+        }
+    };
+    let ea = cable_model.axial_stiffness_n(&scene.cables);
     let model = solver.model();
     let frames = &solution.state.frames;
     let nodes_xyz_m: Vec<[f64; 3]> = node_of
@@ -288,14 +339,16 @@ pub fn verify(
         .collect();
     Ok(Verification {
         truss,
+        cable_model,
+        cable_axial_stiffness_n: ea,
         rms_mm: 1e3 * rms,
         max_deviation_mm: 1e3 * deviations.iter().map(|d| d.abs()).fold(0.0, f64::max),
         max_tension_change_pct: 100.0 * change,
         boundary_deviation_mm: 1e3 * boundary,
         max_node_shift_mm: 1e3 * shift,
         slack_cables,
-        newton_iterations: solution.newton_iterations,
-        load_steps: solution.steps.len(),
+        newton_iterations,
+        load_steps,
         time_s: clock.elapsed().as_secs_f64(),
         nodes_xyz_m,
         tensions_n,
@@ -306,21 +359,25 @@ pub fn verify(
 /// The flexible truss's equilibrium under the design's pull (`None` for a
 /// rigid assembly, or when the truss finds none): the start of the
 /// assembled solve.
+/// With the truss model's constraint scale, by which its multipliers are
+/// divided.
 fn truss_guess(
     scene: &Scene,
     mesh: &ReflectorMesh,
     design: &Design,
     truss: AssemblyTruss,
-) -> Result<Option<State>, VerifyError> {
+) -> Result<Option<(State, f64)>, VerifyError> {
     if truss == AssemblyTruss::Rigid {
         return Ok(None);
     }
     let layout = &mesh.truss;
-    let mut exact = ExactTruss::new(RingTruss::new(scene, layout)?, layout)
-        .map_err(|e| VerifyError::Mismatch(e.to_string()))?;
+    let ring = RingTruss::new(scene, layout)?;
+    let scale = constraint_scale(&ring.model);
+    let mut exact =
+        ExactTruss::new(ring, layout).map_err(|e| VerifyError::Mismatch(e.to_string()))?;
     let pull: Vec<[f64; 3]> = design.reactions_n.iter().map(|r| r.map(|v| -v)).collect();
     Ok(match exact.respond(&pull) {
-        Ok(_) => exact.state().cloned(),
+        Ok(_) => exact.state().cloned().map(|s| (s, scale)),
         Err(_) => None,
     })
 }

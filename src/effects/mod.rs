@@ -7,6 +7,8 @@
 //! | beam model of the ring truss | `truss = "linear" \| "exact"` (and every flexible verification) | [`crate::truss::RingTruss::builder`] | the truss oracle, the assembly, the limit-load search |
 //! | cable self weight | `[effects.gravity]` | [`CableSelfWeight::of`] | the nets' nodal loads (front and rear design stages, the assembly) |
 //! | truss self weight | `[effects.gravity]` | [`truss_self_weight`] | dead loads of the truss model |
+//! | measured rods | `[effects] rod_properties_csv` | [`crate::truss::RingTruss::builder`] (the table: [`crate::scene::Scene::read`]) | the sections of the rods the table names |
+//! | inextensible cables | `[effects] cable_elasticity = false` | [`crate::verify::CableModel::of`] | the verification's cables |
 //!
 //! A new effect is one module here and one line in [`EffectKind`]; the design
 //! loop never changes: the nets and the truss oracle carry the effects in.
@@ -35,6 +37,11 @@ pub enum EffectKind {
     CableSelfWeight,
     /// Dead loads from the self weight of the truss's rods and hinges.
     TrussSelfWeight,
+    /// Measured per-rod sections (`[effects] rod_properties_csv`) applied to
+    /// a beam model.
+    RodProperties,
+    /// Inextensible cables in a verification (`cable_elasticity = false`).
+    InextensibleCables,
 }
 
 thread_local! {

@@ -67,7 +67,31 @@ pub struct State {
     pub(crate) multipliers: Vec<f64>,
 }
 
+/// The constraint scale `s` of a model: the stiffest element's or cable's
+/// axial stiffness EA/L, N/m (it also sets the roundoff floor of the forces).
+pub(crate) fn constraint_scale(model: &Model) -> f64 {
+    model
+        .elements
+        .iter()
+        .map(|e| e.axial_stiffness())
+        .chain(
+            model
+                .cables
+                .iter()
+                .map(|c| c.axial_n() / c.rest_length_m(0.0).min(c.rest_length_m(1.0))),
+        )
+        .fold(0.0, f64::max)
+        .max(1.0)
+}
+
 impl State {
+    /// Multiply every multiplier by `factor`: a state of a model of
+    /// constraint scale `s₁` starts a model of scale `s₂` with
+    /// `factor = s₁/s₂` (the joint forces `s μ` are what carries over).
+    pub(crate) fn rescale_multipliers(&mut self, factor: f64) {
+        self.multipliers.iter_mut().for_each(|m| *m *= factor);
+    }
+
     /// Take the multipliers of the first joints from `other`, a state of a
     /// model whose joints are the first joints of this one (a sub-model).
     ///
@@ -115,20 +139,7 @@ impl System {
             joint_row.push(n_rows);
             n_rows += j.rows();
         }
-        // Constraint scale: the stiffest element's or cable's axial
-        // stiffness EA/L (it also sets the roundoff floor of the forces).
-        let scale = model
-            .elements
-            .iter()
-            .map(|e| e.axial_stiffness())
-            .chain(
-                model
-                    .cables
-                    .iter()
-                    .map(|c| c.axial_n() / c.rest_length_m(0.0).min(c.rest_length_m(1.0))),
-            )
-            .fold(0.0, f64::max)
-            .max(1.0);
+        let scale = constraint_scale(model);
 
         let mut pattern = Vec::new();
         let block = |a: usize, b: usize, pattern: &mut Vec<Pair<usize, usize>>| {

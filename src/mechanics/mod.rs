@@ -21,6 +21,7 @@ pub mod rotation;
 pub mod stability;
 pub mod statics;
 
+pub(crate) use assembly::constraint_scale;
 pub use assembly::State;
 pub use beam::{ElementKind, Frame, Section};
 pub use cable::{Cable, CableState};

@@ -9,10 +9,15 @@
 //! of the net deforms the truss without reactions.
 //!
 //! The scene gives one tube: the thick and thin diagonal tubes use its section
-//! (the paper gives no separate dimensions).
+//! (the paper gives no separate dimensions). A scene with
+//! `[effects] rod_properties_csv` overrides the section of the rods its table
+//! names ([`super::rod_properties`], which also documents the rod names and
+//! their build order: bay by bay, batten, top and bottom longeron, thick and
+//! thin diagonal).
 
 use nalgebra::Vector3;
 
+use super::rod_properties::{RodKind, TrussRod};
 use crate::effects::{self, EffectKind};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::{
@@ -79,7 +84,7 @@ impl RingTruss {
     pub fn builder(scene: &Scene, layout: &RingTrussLayout) -> RingTrussBuilder {
         effects::record(EffectKind::BeamModel);
         let t = &scene.truss;
-        let spec = RodSpec {
+        let nominal = RodSpec {
             section: Section::tube(
                 t.tube_outer_diameter_m,
                 t.tube_inner_diameter_m,
@@ -89,6 +94,17 @@ impl RingTruss {
             elements: t.elements_per_rod,
             kind: t.element,
         };
+        // Measured rods (`[effects] rod_properties_csv`), else the nominal tube.
+        let spec = |kind: RodKind, bay: usize| match &scene.effects.rod_properties {
+            Some(table) => RodSpec {
+                section: table.section(TrussRod::new(kind, bay), &nominal.section),
+                ..nominal
+            },
+            None => nominal,
+        };
+        if scene.effects.rod_properties.is_some() {
+            effects::record(EffectKind::RodProperties);
+        }
         let n = layout.bays();
         let top: Vec<Vector3<f64>> = layout.top_m.iter().map(v).collect();
         let bottom: Vec<Vector3<f64>> = layout.bottom_m.iter().map(v).collect();
@@ -103,7 +119,7 @@ impl RingTruss {
             let normal = (top[next] - top[k]).cross(&(top[k] - bottom[k]));
             let radial_up = top[k] - bottom[k];
 
-            let batten = b.add_rod(bottom[k], top[k], normal, &spec);
+            let batten = b.add_rod(bottom[k], top[k], normal, &spec(RodKind::Batten, k));
             b.add_joint(
                 JointKind::Fixed,
                 batten.start(),
@@ -114,16 +130,19 @@ impl RingTruss {
             rods.push(batten);
 
             let hinge = JointKind::Revolute { axis: normal };
-            for (hinges, points) in [(&top_hinges, &top), (&bottom_hinges, &bottom)] {
-                let longeron = b.add_rod(points[k], points[next], radial_up, &spec);
+            for (hinges, points, kind) in [
+                (&top_hinges, &top, RodKind::TopLongeron),
+                (&bottom_hinges, &bottom, RodKind::BottomLongeron),
+            ] {
+                let longeron = b.add_rod(points[k], points[next], radial_up, &spec(kind, k));
                 b.add_joint(hinge, longeron.start(), hinges[k], points[k]);
                 b.add_joint(hinge, longeron.end(), hinges[next], points[next]);
                 rods.push(longeron);
             }
 
             let middle = (bottom[k] + top[next]) * 0.5;
-            let thick = b.add_rod(bottom[k], middle, normal, &spec);
-            let thin = b.add_rod(middle, top[next], normal, &spec);
+            let thick = b.add_rod(bottom[k], middle, normal, &spec(RodKind::DiagonalThick, k));
+            let thin = b.add_rod(middle, top[next], normal, &spec(RodKind::DiagonalThin, k));
             b.add_joint(hinge, thick.start(), bottom_hinges[k], bottom[k]);
             b.add_joint(JointKind::Fixed, thick.end(), thin.start(), middle);
             b.add_joint(hinge, thin.end(), top_hinges[next], top[next]);

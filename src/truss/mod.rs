@@ -14,6 +14,7 @@ mod exact;
 mod linear;
 mod margin;
 mod rigid;
+mod rod_properties;
 mod scene_response;
 
 pub use builder::{RingTruss, RingTrussBuilder};
@@ -21,6 +22,7 @@ pub use exact::ExactTruss;
 pub use linear::LinearTruss;
 pub use margin::{limit_margin, PRECISION as MARGIN_PRECISION, SEARCH_TO as MARGIN_SEARCH_TO};
 pub use rigid::RigidTruss;
+pub use rod_properties::{RodKind, RodProperties, RodPropertiesError, RodStiffness, TrussRod};
 pub use scene_response::{read_loads, respond, AttachmentResponse, LoadsFile, SceneTrussResponse};
 
 use serde::Serialize;
