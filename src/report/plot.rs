@@ -101,6 +101,28 @@ where
     root.present().map_err(|e| e.to_string())
 }
 
+/// Draws `$draw(area, args…)` — generic over the plotters backend — as a PNG
+/// of `$size` pixels and as an SVG, each file written atomically (the PNG
+/// backend draws to the temporary path of `write_atomic_with`).
+macro_rules! png_and_svg {
+    ($draw:ident, $size:expr, $png:expr, $svg:expr $(, $arg:expr)*) => {{
+        register_font();
+        let (png, svg, size): (&Path, &Path, (u32, u32)) = ($png, $svg, $size);
+        let failure = |path: &Path, message: String| ReportError::Plot {
+            path: path.to_path_buf(),
+            message,
+        };
+        write_atomic_with(png, |temporary| {
+            $draw(BitMapBackend::new(temporary, size).into_drawing_area() $(, $arg)*)
+        })
+        .map_err(|m| failure(png, m))?;
+        let mut text = String::new();
+        $draw(SVGBackend::with_string(&mut text, size).into_drawing_area() $(, $arg)*)
+            .map_err(|m| failure(svg, m))?;
+        write_atomic(svg, text.as_bytes())
+    }};
+}
+
 /// Draws the design front (ratio against actual surface RMS, one curve per
 /// solver) as PNG and SVG, each written atomically.
 pub fn front_plot(
@@ -109,25 +131,7 @@ pub fn front_plot(
     png: &Path,
     svg: &Path,
 ) -> Result<(), ReportError> {
-    register_font();
-    let failure = |path: &Path, message: String| ReportError::Plot {
-        path: path.to_path_buf(),
-        message,
-    };
-    let size = (900u32, 600u32);
-    write_atomic_with(png, |temporary| {
-        let root = BitMapBackend::new(temporary, size).into_drawing_area();
-        draw_front(root, points, title)
-    })
-    .map_err(|m| failure(png, m))?;
-    let mut text = String::new();
-    draw_front(
-        SVGBackend::with_string(&mut text, size).into_drawing_area(),
-        points,
-        title,
-    )
-    .map_err(|m| failure(svg, m))?;
-    write_atomic(svg, text.as_bytes())
+    png_and_svg!(draw_front, (900, 600), png, svg, points, title)
 }
 
 /// Floor of a logarithmic residual axis, m.
@@ -212,28 +216,7 @@ pub fn convergence_plot(
     png: &Path,
     svg: &Path,
 ) -> Result<(), ReportError> {
-    register_font();
-    let failure = |path: &Path, message: String| ReportError::Plot {
-        path: path.to_path_buf(),
-        message,
-    };
-    let size = (900u32, 600u32);
-    write_atomic_with(png, |temporary| {
-        draw_convergence(
-            BitMapBackend::new(temporary, size).into_drawing_area(),
-            series,
-            title,
-        )
-    })
-    .map_err(|m| failure(png, m))?;
-    let mut text = String::new();
-    draw_convergence(
-        SVGBackend::with_string(&mut text, size).into_drawing_area(),
-        series,
-        title,
-    )
-    .map_err(|m| failure(svg, m))?;
-    write_atomic(svg, text.as_bytes())
+    png_and_svg!(draw_convergence, (900, 600), png, svg, series, title)
 }
 
 /// Draws a top view of the surface nodes `(x, y, deviation_mm)`, coloured by
@@ -537,26 +520,5 @@ pub fn study_plot(
     png: &Path,
     svg: &Path,
 ) -> Result<(), ReportError> {
-    register_font();
-    let failure = |path: &Path, message: String| ReportError::Plot {
-        path: path.to_path_buf(),
-        message,
-    };
-    let size = (1600u32, 720u32);
-    write_atomic_with(png, |temporary| {
-        draw_study(
-            BitMapBackend::new(temporary, size).into_drawing_area(),
-            rows,
-            title,
-        )
-    })
-    .map_err(|m| failure(png, m))?;
-    let mut text = String::new();
-    draw_study(
-        SVGBackend::with_string(&mut text, size).into_drawing_area(),
-        rows,
-        title,
-    )
-    .map_err(|m| failure(svg, m))?;
-    write_atomic(svg, text.as_bytes())
+    png_and_svg!(draw_study, (1600, 720), png, svg, rows, title)
 }
