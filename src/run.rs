@@ -1108,7 +1108,7 @@ fn design_margin(
     design: &Design,
 ) -> Result<LimitSearch, Error> {
     // The net pulls on its supports with −F_g.
-    let pull: Vec<[f64; 3]> = design.reactions_n.iter().map(|r| r.map(|v| -v)).collect();
+    let pull = design.pull_n();
     let truss = RingTruss::new(scene, &mesh.truss).map_err(TrussError::from)?;
     let margin = crate::truss::limit_margin(truss, &pull)?;
     match margin.unstable_from {

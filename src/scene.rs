@@ -136,6 +136,15 @@ pub struct Truss {
     pub hinge_mass_kg: f64,
 }
 
+impl Truss {
+    /// Cross-section area of the tubes, m².
+    pub fn tube_area_m2(&self) -> f64 {
+        std::f64::consts::PI
+            * (self.tube_outer_diameter_m.powi(2) - self.tube_inner_diameter_m.powi(2))
+            / 4.0
+    }
+}
+
 /// Largest number of beam elements per truss rod.
 pub const MAX_ELEMENTS_PER_ROD: usize = 64;
 
@@ -182,9 +191,14 @@ pub struct Cables {
 }
 
 impl Cables {
+    /// Cross-section area of one cable, m².
+    pub fn area_m2(&self) -> f64 {
+        std::f64::consts::PI * self.diameter_m * self.diameter_m / 4.0
+    }
+
     /// Axial stiffness `EA` of one cable, N.
     pub fn axial_stiffness_n(&self) -> f64 {
-        self.youngs_modulus_pa * std::f64::consts::PI * self.diameter_m * self.diameter_m / 4.0
+        self.youngs_modulus_pa * self.area_m2()
     }
 
     /// Unstressed (cut) length of a cable of length `length_m` under `tension_n`:

@@ -375,7 +375,7 @@ fn truss_guess(
     let scale = constraint_scale(&ring.model);
     let mut exact =
         ExactTruss::new(ring, layout).map_err(|e| VerifyError::Mismatch(e.to_string()))?;
-    let pull: Vec<[f64; 3]> = design.reactions_n.iter().map(|r| r.map(|v| -v)).collect();
+    let pull = design.pull_n();
     Ok(match exact.respond(&pull) {
         Ok(_) => exact.state().cloned().map(|s| (s, scale)),
         Err(_) => None,

@@ -10,7 +10,7 @@ use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{
     layout_points, limit_margin, oracle, RingTruss, MARGIN_PRECISION, MARGIN_SEARCH_TO,
 };
-use ringmesh::uniformity::{Design, SolverKind};
+use ringmesh::uniformity::SolverKind;
 use ringmesh::verify::{verify, AssemblyTruss};
 
 fn small_hex() -> (Scene, ReflectorMesh, TiedNets) {
@@ -89,18 +89,13 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
     // to the end of the search, its lowest stiffness falling all the way.
     let margin = limit_margin(
         RingTruss::new(&scene, &mesh.truss).unwrap(),
-        &pull(&outcome.design),
+        &outcome.design.pull_n(),
     )
     .unwrap();
     assert_eq!(margin.unstable_from, None, "{margin:?}");
     assert_eq!(margin.stable_to, MARGIN_SEARCH_TO);
     let stiffness: Vec<f64> = margin.path.iter().map(|p| p[1]).collect();
     assert!(stiffness.windows(2).all(|w| w[1] < w[0]), "{stiffness:?}");
-}
-
-/// The net's pull on the truss: minus the support reactions.
-fn pull(design: &Design) -> Vec<[f64; 3]> {
-    design.reactions_n.iter().map(|r| r.map(|v| -v)).collect()
 }
 
 /// DESIGN §9: a design whose pull the truss cannot carry stably is an error,
@@ -134,7 +129,7 @@ fn a_design_past_the_truss_limit_load_is_refused() {
         .unwrap();
     let margin = limit_margin(
         RingTruss::new(&scene, &mesh.truss).unwrap(),
-        &pull(&first.design),
+        &first.design.pull_n(),
     )
     .unwrap();
     let unstable_from = margin.unstable_from.expect("the thin ring buckles");
@@ -194,12 +189,7 @@ fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
         let solver = kind.build(None);
         let c0 = layout_points(&mesh.truss);
         let d0 = nets.design(solver.as_ref(), &c0).unwrap();
-        let pull: Vec<[f64; 3]> = d0
-            .design
-            .reactions_n
-            .iter()
-            .map(|r| r.map(|v| -v))
-            .collect();
+        let pull = d0.design.pull_n();
         let moved = truss.respond(&pull).unwrap().positions_m;
         let d = nets.design(solver.as_ref(), &moved).unwrap();
         let max_tension = d.design.max_tension_n;

@@ -31,50 +31,38 @@ fn small_hex(dir: &Path, gravity: Option<[f64; 3]>) -> PathBuf {
 #[test]
 fn a_scene_builds_only_the_physics_it_asks_for() {
     let dir = tempfile::tempdir().unwrap();
-    let options = |truss| DesignOptions {
-        solver: SolverKind::Bisection,
-        truss: Some(truss),
-        ..DesignOptions::default()
+    // What one `design` run of `scene` with `truss` constructed, per effect.
+    let constructed_by = |scene: &Path, truss| {
+        effects::reset_log();
+        let options = DesignOptions {
+            solver: SolverKind::Bisection,
+            truss: Some(truss),
+            ..DesignOptions::default()
+        };
+        let out = tempfile::tempdir_in(dir.path()).unwrap();
+        design(scene, &options, Some(out.path()), &mut |_, _| {}).unwrap();
+        let log = effects::constructed();
+        move |kind| log.get(&kind).copied().unwrap_or(0)
     };
-    let count = |kind| effects::constructed().get(&kind).copied().unwrap_or(0);
+    let plain_dir = tempfile::tempdir_in(dir.path()).unwrap();
+    let heavy_dir = tempfile::tempdir_in(dir.path()).unwrap();
+    let plain = small_hex(plain_dir.path(), None);
+    let heavy = small_hex(heavy_dir.path(), Some([0.0, 0.0, -1.0]));
 
     // Rigid and weightless: no beam model, no self weight.
-    let plain = small_hex(dir.path(), None);
-    effects::reset_log();
-    design(
-        &plain,
-        &options(TrussModel::Rigid),
-        Some(&dir.path().join("a")),
-        &mut |_, _| {},
-    )
-    .unwrap();
+    let count = constructed_by(&plain, TrussModel::Rigid);
     assert_eq!(count(EffectKind::BeamModel), 0);
     assert_eq!(count(EffectKind::CableSelfWeight), 0);
     assert_eq!(count(EffectKind::TrussSelfWeight), 0);
 
     // Exact and weightless: beam models, still no self weight.
-    effects::reset_log();
-    design(
-        &plain,
-        &options(TrussModel::Exact),
-        Some(&dir.path().join("b")),
-        &mut |_, _| {},
-    )
-    .unwrap();
+    let count = constructed_by(&plain, TrussModel::Exact);
     assert!(count(EffectKind::BeamModel) > 0);
     assert_eq!(count(EffectKind::CableSelfWeight), 0);
     assert_eq!(count(EffectKind::TrussSelfWeight), 0);
 
     // Rigid under gravity: the cables' weight, never a beam model or its weight.
-    let heavy = small_hex(dir.path(), Some([0.0, 0.0, -1.0]));
-    effects::reset_log();
-    design(
-        &heavy,
-        &options(TrussModel::Rigid),
-        Some(&dir.path().join("c")),
-        &mut |_, _| {},
-    )
-    .unwrap();
+    let count = constructed_by(&heavy, TrussModel::Rigid);
     assert!(count(EffectKind::CableSelfWeight) > 0);
     assert_eq!(count(EffectKind::BeamModel), 0);
     assert_eq!(count(EffectKind::TrussSelfWeight), 0);

@@ -245,7 +245,7 @@ pub fn design_loop(
             });
         }
         // The net pulls on its supports with −F_g.
-        let pull: Vec<[f64; 3]> = design.reactions_n.iter().map(|r| r.map(|v| -v)).collect();
+        let pull = design.pull_n();
         let response = oracle
             .respond(&pull)
             .map_err(|source| DesignError::Truss { iteration, source })?;

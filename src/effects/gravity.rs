@@ -29,8 +29,7 @@ impl CableSelfWeight {
         let g = scene.effects.gravity.as_ref()?.vector_m_per_s2();
         record(EffectKind::CableSelfWeight);
         let c = &scene.cables;
-        let mass_per_m =
-            c.density_kg_per_m3 * std::f64::consts::PI * c.diameter_m * c.diameter_m / 4.0;
+        let mass_per_m = c.density_kg_per_m3 * c.area_m2();
         Some(CableSelfWeight {
             weight_n_per_m: g.map(|a| mass_per_m * a),
         })
@@ -69,10 +68,7 @@ pub fn truss_self_weight(
     record(EffectKind::TrussSelfWeight);
     let g = Vector3::from(gravity.vector_m_per_s2());
     let t = &scene.truss;
-    let area = std::f64::consts::PI
-        * (t.tube_outer_diameter_m.powi(2) - t.tube_inner_diameter_m.powi(2))
-        / 4.0;
-    let weight_per_m = t.density_kg_per_m3 * area * g;
+    let weight_per_m = t.density_kg_per_m3 * t.tube_area_m2() * g;
     let position = |n: NodeId| builder.frame(n).map(|f| f.position_m);
     let mut loads = Vec::new();
     for rod in rods {

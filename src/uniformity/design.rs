@@ -101,6 +101,12 @@ pub struct Design {
 }
 
 impl Design {
+    /// The net's pull on its supports, `−F_g`, N (the order of `fixed`):
+    /// the loads a truss oracle takes.
+    pub fn pull_n(&self) -> Vec<[f64; 3]> {
+        self.reactions_n.iter().map(|r| r.map(|v| -v)).collect()
+    }
+
     /// Judges `q` on `problem`: forward solve, tensions, spreads, residual, surface
     /// error. The caller supplies how its solver stopped.
     pub fn evaluate(
