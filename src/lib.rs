@@ -30,6 +30,7 @@
 //! * [`shard`] — sweeps split across machines and merged back.
 #![warn(missing_docs)]
 
+pub mod algebra;
 pub mod design;
 pub mod effects;
 pub mod fdm;

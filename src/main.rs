@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
+use ringmesh::algebra::norm3;
 use ringmesh::design::Relaxation;
 use ringmesh::mechanics::{ElementKind, StaticTermination};
 use ringmesh::run::{CantileverTable, FrameOutput, Progress};
@@ -626,12 +627,12 @@ fn frame_summary(o: &FrameOutput) -> String {
     let reaction = o
         .reactions
         .iter()
-        .map(|r| norm(r.force_n))
+        .map(|r| norm3(r.force_n))
         .fold(0.0, f64::max);
     let moment = o
         .reactions
         .iter()
-        .map(|r| norm(r.moment_nm))
+        .map(|r| norm3(r.moment_nm))
         .fold(0.0, f64::max);
     let at = match o.nodes.get(o.max_displacement_node) {
         Some(largest) => match (&largest.rod, largest.rod_node, &largest.body) {
@@ -660,10 +661,6 @@ fn frame_summary(o: &FrameOutput) -> String {
         reaction,
         moment
     )
-}
-
-fn norm(v: [f64; 3]) -> f64 {
-    v.iter().map(|c| c * c).sum::<f64>().sqrt()
 }
 
 /// The cantilever table, one load per line.

@@ -12,6 +12,8 @@ use std::path::Path;
 use faer::sparse::{SparseColMat, Triplet};
 use serde::{Deserialize, Serialize};
 
+use crate::algebra::norm3;
+
 /// The role of a cable in a reflector's mesh; its name is the group label of the
 /// interchange format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -459,10 +461,6 @@ pub(crate) fn edges_vectors(edges: &[[usize; 2]], nodes: &[[f64; 3]]) -> Vec<[f6
         .collect()
 }
 
-/// Euclidean norm of a 3-vector.
-pub fn norm3(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
 
 #[cfg(test)]
 mod tests {

@@ -18,7 +18,8 @@ use crate::mechanics::{
     rotation, ElementKind, FrameFile, FrameFileError, LimitSearch, NodeOrigin, StaticSolver,
     StaticTermination, StepRecord,
 };
-use crate::network::{norm3, Network, NetworkSummary};
+use crate::algebra::norm3;
+use crate::network::{Network, NetworkSummary};
 use crate::report::{
     assembly_vtu, cables_csv, convergence_plot, front_csv, front_plot, front_row, network_vtu,
     parse_front_row, parse_study_row, study_csv, study_plot, study_row, surface_plot, write_atomic,

@@ -1,0 +1,52 @@
+//! Small dense vector kernels shared by every module (Clarabel keeps its
+//! `algebra/` apart from the solvers the same way): dot products and norms of
+//! slices and of 3-vectors. Anything larger goes to faer or nalgebra.
+
+/// `aᵀb` of two slices of equal length.
+///
+/// # Panics
+/// In debug builds, when the lengths differ.
+#[inline]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    debug_assert_eq!(a.len(), b.len());
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Euclidean norm `‖a‖₂` of a slice.
+#[inline]
+pub fn norm2(a: &[f64]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Largest magnitude `‖a‖∞` of a slice (0 for an empty one).
+#[inline]
+pub fn norm_inf(a: &[f64]) -> f64 {
+    a.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// Euclidean norm of a 3-vector.
+#[inline]
+pub fn norm3(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// `a − b` of two 3-vectors.
+#[inline]
+pub fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn norms_of_a_pythagorean_vector() {
+        assert_eq!(norm2(&[3.0, 4.0]), 5.0);
+        assert_eq!(norm3([2.0, 3.0, 6.0]), 7.0);
+        assert_eq!(norm_inf(&[1.0, -8.0, 2.0]), 8.0);
+        assert_eq!(norm_inf(&[]), 0.0);
+        assert_eq!(dot(&[1.0, 2.0], &[3.0, -1.0]), 1.0);
+        assert_eq!(sub3([1.0, 2.0, 3.0], [1.0, 1.0, 1.0]), [0.0, 1.0, 2.0]);
+    }
+}
