@@ -15,7 +15,8 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, Symbol
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, Mat, MatMut, Par, Side};
 
-use crate::network::{edges_vectors, norm3, Network, NetworkError};
+use crate::algebra::norm3;
+use crate::network::{edges_vectors, Network, NetworkError};
 
 /// Marks "no such index" in the dense index maps below.
 pub(crate) const NONE: usize = usize::MAX;

@@ -461,7 +461,6 @@ pub(crate) fn edges_vectors(edges: &[[usize; 2]], nodes: &[[f64; 3]]) -> Vec<[f6
         .collect()
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use crate::algebra::norm3;
 use crate::design::{
     design_loop, DesignError, IterationRecord, LoopOutcome, LoopSettings, LoopTermination,
     Relaxation, TiedNets,
@@ -18,7 +19,6 @@ use crate::mechanics::{
     rotation, ElementKind, FrameFile, FrameFileError, LimitSearch, NodeOrigin, StaticSolver,
     StaticTermination, StepRecord,
 };
-use crate::algebra::norm3;
 use crate::network::{Network, NetworkSummary};
 use crate::report::{
     assembly_vtu, cables_csv, convergence_plot, front_csv, front_plot, front_row, network_vtu,

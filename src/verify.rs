@@ -23,12 +23,13 @@ use std::time::Instant;
 use nalgebra::Vector3;
 use serde::Serialize;
 
+use crate::algebra::norm3;
 use crate::geometry::ReflectorMesh;
 use crate::mechanics::{constraint_scale, State};
 use crate::mechanics::{
     MechanicsError, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver, StaticTermination,
 };
-use crate::network::{norm3, Network};
+use crate::network::Network;
 use crate::scene::Scene;
 use crate::truss::{ExactTruss, RingTruss, RingTrussBuilder, TrussOracle};
 use crate::uniformity::Design;

@@ -15,7 +15,8 @@
 //! node to the rear node below it.
 
 use super::{Aperture, Paraboloid, RingTrussLayout};
-use crate::network::{edges_vectors, norm3, CableGroup, Network};
+use crate::algebra::norm3;
+use crate::network::{edges_vectors, CableGroup, Network};
 use crate::scene::{Scene, SceneError};
 
 /// Largest number of net nodes (front + rear) a scene may generate.

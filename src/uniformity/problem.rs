@@ -2,9 +2,10 @@
 //! every solver: a prescribed geometry, uniformity sets, bounds, loads, and the
 //! surface whose accuracy a design is judged by.
 
+use crate::algebra::norm3;
 use crate::fdm::{Equilibrium, FdmStructure};
 use crate::geometry::{Paraboloid, ReflectorMesh};
-use crate::network::{norm3, Network};
+use crate::network::Network;
 
 use super::UniformityError;
 
