@@ -20,8 +20,8 @@ use criterion::measurement::WallTime;
 use criterion::{
     criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion, SamplingMode,
 };
+use ringmesh::design::SceneNets;
 use ringmesh::design::{LoopOutcome, LoopSettings};
-use ringmesh::run::SceneNets;
 use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::uniformity::{SolverKind, UniformitySolver};
 use ringmesh::verify::{verify, AssemblyTruss};

@@ -17,7 +17,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use ringmesh::run::scene_problem;
+use ringmesh::design::scene_problem;
 use ringmesh::uniformity::{
     Bisection, Gradient, Lp, SolverKind, UniformityProblem, UniformitySolver,
 };

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use ringmesh::algebra::norm3;
-use ringmesh::design::Relaxation;
+use ringmesh::design::RelaxationKind;
 use ringmesh::mechanics::{ElementKind, StaticTermination};
 use ringmesh::run::{CantileverTable, FrameOutput, Progress};
 use ringmesh::scene::TrussModel;
@@ -83,7 +83,7 @@ enum Command {
         /// Relaxation policies, comma-separated: the first makes the design, the
         /// others are run for the convergence comparison.
         #[arg(long, value_enum, value_delimiter = ',', default_value = "anderson")]
-        relaxation: Vec<Relaxation>,
+        relaxation: Vec<RelaxationKind>,
         /// Stop when the boundary moves by at most this, m.
         #[arg(long, default_value_t = 1e-6)]
         tol: f64,
@@ -333,7 +333,7 @@ fn main() -> ExitCode {
             max_iterations,
             output,
         } => {
-            let options = ringmesh::run::DesignOptions {
+            let options = ringmesh::design::DesignSettings {
                 solver: *solver,
                 truss: *truss,
                 relaxations: relaxation.clone(),

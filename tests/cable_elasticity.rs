@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use ringmesh::design::{design_loop, LoopSettings, LoopTermination, Relaxation, TiedNets};
+use ringmesh::design::scene_problem;
+use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
 use ringmesh::geometry::ReflectorMesh;
-use ringmesh::run::scene_problem;
 use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{layout_points, oracle};
 use ringmesh::uniformity::{Design, SolverKind};
@@ -117,7 +117,7 @@ fn the_design_for_the_deforming_truss_survives_inextensible_assembly() {
     let solver = SolverKind::Lp.build(None);
     let mut truss = oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
     let settings = LoopSettings {
-        relaxation: Relaxation::Anderson,
+        relaxation: RelaxationKind::Anderson,
         tolerance_m: 1e-7,
         max_iterations: 40,
         ..LoopSettings::default()

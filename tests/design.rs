@@ -3,9 +3,10 @@
 
 use std::path::Path;
 
-use ringmesh::design::{design_loop, LoopSettings, LoopTermination, Relaxation, TiedNets};
+use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
+use ringmesh::design::{scene_problem, DesignSettings};
 use ringmesh::geometry::ReflectorMesh;
-use ringmesh::run::{design, scene_problem, DesignOptions};
+use ringmesh::run::design;
 use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{
     layout_points, limit_margin, oracle, RingTruss, MARGIN_PRECISION, MARGIN_SEARCH_TO,
@@ -20,7 +21,7 @@ fn small_hex() -> (Scene, ReflectorMesh, TiedNets) {
     (scene, mesh, nets)
 }
 
-fn settings(relaxation: Relaxation) -> LoopSettings {
+fn settings(relaxation: RelaxationKind) -> LoopSettings {
     LoopSettings {
         relaxation,
         tolerance_m: 1e-7,
@@ -41,7 +42,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
         &nets,
         solver.as_ref(),
         truss.as_mut(),
-        &settings(Relaxation::Anderson),
+        &settings(RelaxationKind::Anderson),
         &mut |_| {},
     )
     .unwrap();
@@ -145,7 +146,7 @@ fn a_design_past_the_truss_limit_load_is_refused() {
     let out = dir.path().join("out");
     let error = design(
         &scene_path,
-        &DesignOptions::default(),
+        &DesignSettings::default(),
         Some(&out),
         &mut |_, _| {},
     )
@@ -214,7 +215,11 @@ fn rigid_truss_loop_stops_after_one_design() {
     let (scene, mesh, nets) = small_hex();
     let solver = SolverKind::Lp.build(None);
     let mut truss = oracle(TrussModel::Rigid, &scene, &mesh.truss).unwrap();
-    for relaxation in [Relaxation::Paper, Relaxation::Aitken, Relaxation::Anderson] {
+    for relaxation in [
+        RelaxationKind::Paper,
+        RelaxationKind::Aitken,
+        RelaxationKind::Anderson,
+    ] {
         let outcome = design_loop(
             &nets,
             solver.as_ref(),
@@ -253,9 +258,9 @@ fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
         assert!(outcome.boundary_residual_m() <= 1e-7);
         outcome.history.len()
     };
-    let anderson = iterations(Relaxation::Anderson);
-    let paper = iterations(Relaxation::Paper);
-    let aitken = iterations(Relaxation::Aitken);
+    let anderson = iterations(RelaxationKind::Anderson);
+    let paper = iterations(RelaxationKind::Paper);
+    let aitken = iterations(RelaxationKind::Aitken);
     assert!(anderson < paper, "Anderson {anderson}, paper {paper}");
     assert!(anderson <= aitken, "Anderson {anderson}, Aitken {aitken}");
 }

@@ -5,11 +5,12 @@
 use std::path::{Path, PathBuf};
 
 use ringmesh::design::TiedNets;
+use ringmesh::design::{scene_problem, DesignSettings};
 use ringmesh::effects::{self, CableSelfWeight, EffectKind};
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::{build_mesh, ReflectorMesh};
 use ringmesh::network::CableGroup;
-use ringmesh::run::{design, scene_problem, DesignOptions};
+use ringmesh::run::design;
 use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{layout_points, RingTruss};
 use ringmesh::uniformity::{Design, SolverKind};
@@ -34,10 +35,10 @@ fn a_scene_builds_only_the_physics_it_asks_for() {
     // What one `design` run of `scene` with `truss` constructed, per effect.
     let constructed_by = |scene: &Path, truss| {
         effects::reset_log();
-        let options = DesignOptions {
+        let options = DesignSettings {
             solver: SolverKind::Bisection,
             truss: Some(truss),
-            ..DesignOptions::default()
+            ..DesignSettings::default()
         };
         let out = tempfile::tempdir_in(dir.path()).unwrap();
         design(scene, &options, Some(out.path()), &mut |_, _| {}).unwrap();

@@ -11,6 +11,7 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use nalgebra::{UnitQuaternion, Vector3};
+use ringmesh::design::scene_problem;
 use ringmesh::design::TiedNets;
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::build_mesh;
@@ -20,7 +21,6 @@ use ringmesh::mechanics::{
     StaticSettings, StaticSolver, StaticTermination,
 };
 use ringmesh::network::{Network, NetworkError};
-use ringmesh::run::scene_problem;
 use ringmesh::scene::TrussModel;
 use ringmesh::truss::{self, layout_points, RingTruss, TrussError};
 use ringmesh::uniformity::{

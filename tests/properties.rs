@@ -9,9 +9,9 @@
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
+use ringmesh::design::scene_problem;
 use ringmesh::fdm::solve_network;
 use ringmesh::mechanics::rotation::{exp, log, skew};
-use ringmesh::run::scene_problem;
 use ringmesh::scene::Scene;
 use ringmesh::uniformity::{SolverKind, Termination};
 use ringmesh::Network;

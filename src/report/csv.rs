@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use crate::design::LoopTermination;
+use crate::design::{LoopRun, LoopTermination};
 use crate::network::Network;
 use crate::scene::{Cables, TrussModel};
 use crate::study::{value_name, Knob, RunSettings, StudyRow};
@@ -268,6 +268,34 @@ fn number(text: &str, name: &str) -> Result<f64, String> {
 fn whole(text: &str, name: &str) -> Result<usize, String> {
     text.parse()
         .map_err(|_| format!("{name}: {text:?} is not a whole number"))
+}
+
+/// `relaxation,iteration,…`: one row per outer iteration of every run.
+pub fn convergence_csv(runs: &[LoopRun]) -> String {
+    let mut s = String::from(
+        "relaxation,iteration,boundary_change_max_m,boundary_change_rms_m,xi_change_m,ratio,\
+         relaxation_factor,oracle_newton_iterations,design_time_s,truss_time_s,elapsed_s\n",
+    );
+    for run in runs {
+        for r in &run.history {
+            let _ = writeln!(
+                s,
+                "{},{},{:e},{:e},{},{:.12e},{:e},{},{:e},{:e},{:e}",
+                run.relaxation.name(),
+                r.iteration,
+                r.boundary_change_max_m,
+                r.boundary_change_rms_m,
+                r.xi_change_m.map_or(String::new(), |v| format!("{v:e}")),
+                r.ratio,
+                r.relaxation_factor,
+                r.oracle_newton_iterations,
+                r.design_time_s,
+                r.truss_time_s,
+                r.elapsed_s
+            );
+        }
+    }
+    s
 }
 
 #[cfg(test)]

@@ -50,8 +50,8 @@ use serde::{Deserialize, Serialize};
 
 pub use pareto::pareto_optimal;
 
+use crate::design::SceneNets;
 use crate::design::{LoopSettings, LoopTermination};
-use crate::run::SceneNets;
 use crate::scene::{Scene, TrussModel, MAX_ELEMENTS_PER_ROD};
 use crate::shard::Shard;
 use crate::uniformity::SolverKind;

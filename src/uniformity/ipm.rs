@@ -1108,7 +1108,7 @@ pub(crate) mod tests {
 
     fn problem(path: &str) -> UniformityProblem {
         let scene = crate::Scene::read(std::path::Path::new(path)).expect("scene");
-        crate::run::scene_problem(&scene).expect("problem").1
+        crate::design::scene_problem(&scene).expect("problem").1
     }
 
     /// `Tmax/Tmin` of `q` over the problem's first set.

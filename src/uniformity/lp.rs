@@ -157,7 +157,7 @@ mod tests {
     /// and the completed `q` balances every free node of both nets.
     fn plan_matches_full(path: &str) {
         let scene = crate::Scene::read(std::path::Path::new(path)).expect("scene");
-        let problem = crate::run::scene_problem(&scene).expect("problem").1;
+        let problem = crate::design::scene_problem(&scene).expect("problem").1;
         let plan = PlanReduction::new(&problem).expect("a reflector mesh");
         let network = problem.network();
         let ties = (0..network.n_edges())

@@ -1,0 +1,277 @@
+//! The whole job of `ringmesh design`, as one library call ([`run`]): the
+//! scene's nets, the outer loop with each relaxation asked for, the truss's
+//! margin to its limit load under the design's pull, the design cut to length
+//! and assembled on the flexible truss, and the conventional design — the
+//! loop's iteration 0, made for the undeformed truss — assembled on the same
+//! truss (paper §5, Figure 2).
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::outer_loop::{IterationRecord, LoopSettings, LoopTermination};
+use super::relaxation::RelaxationKind;
+use super::scene_nets::SceneNets;
+use super::DesignError;
+use crate::geometry::ReflectorMesh;
+use crate::mechanics::LimitSearch;
+use crate::network::Network;
+use crate::scene::{Scene, TrussModel};
+use crate::truss::{RingTruss, TrussError};
+use crate::uniformity::{Design, SolverKind};
+use crate::verify::{verify, AssemblyTruss, Verification};
+use crate::Error;
+
+/// Choices of a design run: plain data with defaults.
+#[derive(Debug, Clone)]
+pub struct DesignSettings {
+    /// The uniformity solver.
+    pub solver: SolverKind,
+    /// The truss model (default: the scene's `[effects] truss`).
+    pub truss: Option<TrussModel>,
+    /// Relaxation policies: the first makes the design; the others only add
+    /// their convergence histories for comparison.
+    pub relaxations: Vec<RelaxationKind>,
+    /// Stopping tolerance on `‖G(C) − C‖∞`, m.
+    pub tolerance_m: f64,
+    /// Most outer iterations.
+    pub max_iterations: usize,
+}
+
+impl Default for DesignSettings {
+    fn default() -> Self {
+        let loop_settings = LoopSettings::default();
+        DesignSettings {
+            solver: SolverKind::Lp,
+            truss: None,
+            relaxations: vec![loop_settings.relaxation],
+            tolerance_m: loop_settings.tolerance_m,
+            max_iterations: loop_settings.max_iterations,
+        }
+    }
+}
+
+/// One relaxation policy's run of the outer loop.
+#[derive(Debug, Clone, Serialize)]
+pub struct LoopRun {
+    /// The policy.
+    pub relaxation: RelaxationKind,
+    /// How it ended.
+    pub termination: LoopTermination,
+    /// Outer iterations (designs made).
+    pub outer_iterations: usize,
+    /// Final `‖G(C) − C‖∞`, m.
+    pub boundary_residual_m: f64,
+    /// Wall time, s.
+    pub time_s: f64,
+    /// Per iteration.
+    pub history: Vec<IterationRecord>,
+    /// Why a comparison run stopped without a result (the truss found no
+    /// equilibrium once the iteration ran away, say).
+    pub error: Option<String>,
+}
+
+/// `design.json`: the outer loop's design, its verification by assembly, and
+/// the conventional (rigid-truss) design verified on the same truss.
+#[derive(Debug, Clone, Serialize)]
+pub struct DesignReport {
+    /// The scene's name.
+    pub scene: String,
+    /// The uniformity solver.
+    pub solver: String,
+    /// The truss model of the loop.
+    pub truss: TrussModel,
+    /// The relaxation policy that made the design.
+    pub relaxation: RelaxationKind,
+    /// How the loop ended.
+    pub termination: LoopTermination,
+    /// Outer iterations.
+    pub outer_iterations: usize,
+    /// Final fixed-point residual `‖G(C) − C‖∞`, m.
+    pub boundary_residual_m: f64,
+    /// The design's largest set ratio `Tmax/Tmin`.
+    pub ratio: f64,
+    /// Wall time of the whole run (every loop, verifications), s.
+    pub time_s: f64,
+    /// The design loop's iterations.
+    pub history: Vec<IterationRecord>,
+    /// Every policy run, the design's first.
+    pub runs: Vec<LoopRun>,
+    /// The design cut to length and assembled.
+    pub verification: Verification,
+    /// The rigid-truss design assembled on the same truss (absent when the
+    /// loop's truss is rigid: then it is the design itself).
+    pub conventional: Option<Verification>,
+    /// The flexible truss's limit load under the design's pull (DESIGN §9):
+    /// stable up to `stable_to` × the pull (absent for a rigid truss).
+    pub limit_margin: Option<LimitSearch>,
+    /// The boundary the design is made for, `C` (top hinges, then bottom), m.
+    pub boundary_m: Vec<[f64; 3]>,
+    /// The design: q, tensions, lengths, nodes, reactions, spreads.
+    pub net: Design,
+}
+
+/// A design run: the report and what its files are drawn from.
+#[derive(Debug)]
+pub struct DesignRun {
+    /// The report (`design.json`).
+    pub report: DesignReport,
+    /// The scene's nets and truss layout.
+    pub mesh: ReflectorMesh,
+    /// The network at the design's geometry (the final boundary `C`).
+    pub network: Network,
+}
+
+/// The outer design loop (net design ⇄ truss response) of `scene` with each
+/// relaxation `settings` asks for, the design verified by assembly, its
+/// margin to the truss's limit load, and the conventional design (the loop's
+/// iteration 0) verified on the same truss. `observe` sees each outer
+/// iteration of each policy.
+///
+/// # Errors
+/// Invalid settings or scene values, a design or truss that fails, or a pull
+/// past the truss's limit load ([`TrussError::PastLimitLoad`]); a comparison
+/// policy that fails is recorded in its [`LoopRun`], not an error.
+pub fn run(
+    scene: &Scene,
+    settings: &DesignSettings,
+    observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
+) -> Result<DesignRun, Error> {
+    let clock = Instant::now();
+    let model = settings.truss.unwrap_or(scene.effects.truss);
+    let scene_nets = SceneNets::new(scene)?;
+    let (mesh, nets) = (&scene_nets.mesh, &scene_nets.nets);
+    let solver = settings.solver.build(None);
+    let relaxations = if settings.relaxations.is_empty() {
+        vec![RelaxationKind::default()]
+    } else {
+        settings.relaxations.clone()
+    };
+    let mut runs = Vec::new();
+    let mut outcome = None;
+    for &relaxation in &relaxations {
+        let loop_settings = LoopSettings {
+            relaxation,
+            tolerance_m: settings.tolerance_m,
+            max_iterations: settings.max_iterations,
+            ..LoopSettings::default()
+        };
+        let mut history = Vec::new();
+        let result =
+            scene_nets.design_loop(scene, solver.as_ref(), model, &loop_settings, &mut |r| {
+                history.push(r.clone());
+                observe(relaxation, r)
+            });
+        match result {
+            Ok(result) => {
+                runs.push(LoopRun {
+                    relaxation,
+                    termination: result.termination,
+                    outer_iterations: result.history.len(),
+                    boundary_residual_m: result.boundary_residual_m(),
+                    time_s: result.time_s,
+                    history: result.history.clone(),
+                    error: None,
+                });
+                outcome.get_or_insert(result);
+            }
+            // A comparison run may fail without losing the design.
+            Err(e) if outcome.is_some() => runs.push(LoopRun {
+                relaxation,
+                termination: LoopTermination::Diverged,
+                outer_iterations: history.len(),
+                boundary_residual_m: history.last().map_or(f64::NAN, |r| r.boundary_change_max_m),
+                time_s: history.last().map_or(0.0, |r| r.elapsed_s),
+                history,
+                error: Some(e.to_string()),
+            }),
+            // No truss equilibrium: say how far below the pull the truss's
+            // stability ends (the rigid-truss design's pull, the loop's first).
+            Err(
+                e @ Error::Design(DesignError::Truss {
+                    source: TrussError::NoEquilibrium { .. },
+                    ..
+                }),
+            ) => {
+                let first =
+                    nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
+                return Err(match design_margin(scene, mesh, &first.design) {
+                    Err(past) => past,
+                    Ok(_) => e,
+                });
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    let outcome = outcome.expect("at least one relaxation");
+    let assembly = if model == TrussModel::Rigid {
+        AssemblyTruss::Rigid
+    } else {
+        AssemblyTruss::Flexible
+    };
+    let limit_margin = match assembly {
+        AssemblyTruss::Rigid => None,
+        AssemblyTruss::Flexible => Some(design_margin(scene, mesh, &outcome.design)?),
+    };
+    let network = outcome.problem.network().clone();
+    let verification = verify(scene, mesh, &network, &outcome.design, assembly)?;
+    // The conventional design is the loop's iteration 0: the design for the
+    // undeformed attachment points.
+    let conventional = match assembly {
+        AssemblyTruss::Rigid => None,
+        AssemblyTruss::Flexible => Some(verify(
+            scene,
+            mesh,
+            outcome.initial.problem.network(),
+            &outcome.initial.design,
+            AssemblyTruss::Flexible,
+        )?),
+    };
+    let report = DesignReport {
+        scene: scene.name.clone(),
+        solver: solver.name().to_string(),
+        truss: model,
+        relaxation: relaxations[0],
+        termination: outcome.termination,
+        outer_iterations: outcome.history.len(),
+        boundary_residual_m: outcome.boundary_residual_m(),
+        ratio: outcome.design.ratio,
+        time_s: clock.elapsed().as_secs_f64(),
+        history: outcome.history.clone(),
+        runs,
+        verification,
+        conventional,
+        limit_margin,
+        boundary_m: outcome.boundary_m.clone(),
+        net: outcome.design,
+    };
+    Ok(DesignRun {
+        report,
+        mesh: scene_nets.mesh,
+        network,
+    })
+}
+
+/// The margin of `scene`'s truss to its limit load under `design`'s pull.
+///
+/// # Errors
+/// A truss that cannot be built, or a pull it cannot carry stably
+/// ([`TrussError::PastLimitLoad`]).
+pub fn design_margin(
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    design: &Design,
+) -> Result<LimitSearch, Error> {
+    // The net pulls on its supports with −F_g.
+    let pull = design.pull_n();
+    let truss = RingTruss::new(scene, &mesh.truss).map_err(TrussError::from)?;
+    let margin = crate::truss::limit_margin(truss, &pull)?;
+    match margin.unstable_from {
+        Some(unstable_from) if margin.stable_to < 1.0 => Err(TrussError::PastLimitLoad {
+            stable_to: margin.stable_to,
+            unstable_from,
+        }
+        .into()),
+        _ => Ok(margin),
+    }
+}

@@ -1,0 +1,75 @@
+//! A scene's nets ready for the outer loop: the mesh, the front net's
+//! uniformity problem for the theoretical boundary, and the two-stage design
+//! problem built on it, with the loads of the effects the scene asks for.
+
+use super::outer_loop::{design_loop, IterationRecord, LoopOutcome, LoopSettings};
+use super::tied_nets::TiedNets;
+use crate::effects::CableSelfWeight;
+use crate::geometry::{build_mesh, ReflectorMesh};
+use crate::scene::{Scene, TrussModel};
+use crate::uniformity::{UniformityProblem, UniformitySolver};
+use crate::Error;
+
+/// The uniformity problem of a scene's front net for its theoretical boundary,
+/// under the cables' self weight when the scene asks for gravity.
+///
+/// # Errors
+/// A mesh or uniformity problem that cannot be built.
+pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem), Error> {
+    let mesh = build_mesh(scene)?;
+    let mut problem = UniformityProblem::from_mesh(
+        &mesh,
+        &scene.uniformity_targets(),
+        scene.cables.max_force_density_n_per_m,
+    )?;
+    problem.min_tension_fraction = scene.uniformity.min_tension_fraction;
+    let weights =
+        CableSelfWeight::of(scene).map(|w| w.nodal_loads(&mesh.network.nodes, &mesh.network.edges));
+    Ok((mesh, problem.with_loads(weights)?))
+}
+
+/// A scene's nets ready for the outer loop: the mesh and its two-stage
+/// design problem ([`TiedNets`]).
+pub struct SceneNets {
+    /// The scene's nets and truss layout.
+    pub mesh: ReflectorMesh,
+    /// The two-stage design problem on them.
+    pub nets: TiedNets,
+}
+
+impl SceneNets {
+    /// Builds the mesh and the design problem of `scene`.
+    ///
+    /// # Errors
+    /// An invalid mesh or uniformity problem.
+    pub fn new(scene: &Scene) -> Result<SceneNets, Error> {
+        let (mesh, problem) = scene_problem(scene)?;
+        let nets =
+            TiedNets::new(&mesh, problem)?.with_cable_self_weight(CableSelfWeight::of(scene));
+        Ok(SceneNets { mesh, nets })
+    }
+
+    /// One run of the outer loop (net design ⇄ truss response) with a fresh
+    /// truss oracle of `model` (the scene's truss values), calling `observe`
+    /// after every iteration.
+    ///
+    /// # Errors
+    /// A truss that cannot be built, or the loop's errors.
+    pub fn design_loop(
+        &self,
+        scene: &Scene,
+        solver: &dyn UniformitySolver,
+        model: TrussModel,
+        settings: &LoopSettings,
+        observe: &mut dyn FnMut(&IterationRecord),
+    ) -> Result<LoopOutcome, Error> {
+        let mut oracle = crate::truss::oracle(model, scene, &self.mesh.truss)?;
+        Ok(design_loop(
+            &self.nets,
+            solver,
+            oracle.as_mut(),
+            settings,
+            observe,
+        )?)
+    }
+}

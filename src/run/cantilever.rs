@@ -1,0 +1,56 @@
+//! `ringmesh cantilever`: the paper's cantilever under a tip moment (§3.4,
+//! Tables 1–2) beside the closed form and the paper's figures.
+
+use serde::Serialize;
+
+use crate::mechanics::cantilever::{self, CantileverRow};
+use crate::mechanics::{ElementKind, FrameFileError};
+use crate::Error;
+
+/// One row of `ringmesh cantilever`: the engine's row and the paper's result
+/// where the paper gives one.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CantileverTableRow {
+    /// Ours, the closed form, the error and the solver's statistics.
+    #[serde(flatten)]
+    pub row: CantileverRow,
+    /// The paper's tip axial displacement (Tables 1–2, 10 elements), m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub paper_axial_m: Option<f64>,
+    /// The paper's tip vertical displacement, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub paper_vertical_m: Option<f64>,
+}
+
+/// The output of `ringmesh cantilever`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CantileverTable {
+    /// Elements along the cantilever.
+    pub elements: usize,
+    /// The element type.
+    pub element: String,
+    /// One row per load `ML/(πEI)` of [`cantilever::M_RATIOS`].
+    pub rows: Vec<CantileverTableRow>,
+}
+
+/// `ringmesh cantilever`: the paper's Tables 1–2 (§3.4) with `elements`
+/// elements of `kind`, every load from 0.2 to the full circle.
+pub fn cantilever(elements: usize, kind: ElementKind) -> Result<CantileverTable, Error> {
+    let rows = cantilever::table(elements, kind)
+        .map_err(FrameFileError::from)?
+        .into_iter()
+        .map(|row| {
+            let paper = cantilever::PAPER.iter().find(|p| p.0 == row.m_ratio);
+            CantileverTableRow {
+                paper_axial_m: paper.map(|p| p.1),
+                paper_vertical_m: paper.map(|p| p.2),
+                row,
+            }
+        })
+        .collect();
+    Ok(CantileverTable {
+        elements,
+        element: kind.name().to_string(),
+        rows,
+    })
+}

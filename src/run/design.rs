@@ -1,0 +1,119 @@
+//! `ringmesh design`: the whole design job ([`crate::design::run`]) and its
+//! files, each written atomically once everything is computed.
+
+use std::path::{Path, PathBuf};
+
+use super::default_output_dir;
+use crate::design::{DesignReport, DesignSettings, IterationRecord, RelaxationKind};
+use crate::geometry::ReflectorMesh;
+use crate::network::Network;
+use crate::report::{
+    assembly_vtu, cables_csv, convergence_csv, convergence_plot, surface_plot, write_atomic,
+    write_json,
+};
+use crate::scene::Scene;
+use crate::Error;
+
+/// What `ringmesh design` made.
+#[derive(Debug)]
+pub struct DesignOutcome {
+    /// The report (also in `design.json`).
+    pub report: DesignReport,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// `ringmesh design`: reads the scene, runs [`crate::design::run`] and writes
+/// `design.json`, `cables.csv`, `convergence.csv/.png/.svg`,
+/// `surface-error.png` and `model.vtu` into `output_dir` (default
+/// `results/<scene>/`). `observe` sees each outer iteration.
+///
+/// # Errors
+/// The scene's, the design's and the writers' errors; nothing is written
+/// unless everything was computed.
+pub fn design(
+    scene_path: &Path,
+    settings: &DesignSettings,
+    output_dir: Option<&Path>,
+    observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
+) -> Result<DesignOutcome, Error> {
+    let scene = Scene::read(scene_path)?;
+    let run = crate::design::run(&scene, settings, observe)?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let written = write_design(&dir, &scene, &run.mesh, &run.network, &run.report)?;
+    Ok(DesignOutcome {
+        report: run.report,
+        written,
+    })
+}
+
+/// The files of `ringmesh design`, each written atomically.
+fn write_design(
+    dir: &Path,
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    network: &Network,
+    report: &DesignReport,
+) -> Result<Vec<PathBuf>, Error> {
+    let path = |name: &str| dir.join(name);
+    let series: Vec<(String, Vec<(usize, f64)>)> = report
+        .runs
+        .iter()
+        .map(|run| {
+            (
+                run.relaxation.name().to_string(),
+                run.history
+                    .iter()
+                    .map(|r| (r.iteration, r.boundary_change_max_m))
+                    .collect(),
+            )
+        })
+        .collect();
+    convergence_plot(
+        &series,
+        &format!("{}: outer design loop", scene.name),
+        &path("convergence.png"),
+        &path("convergence.svg"),
+    )?;
+    let fixed = network.fixed_mask();
+    let surface: Vec<(f64, f64, f64)> = (0..mesh.n_front_nodes)
+        .filter(|&i| !fixed[i])
+        .map(|i| {
+            let p = report.verification.nodes_xyz_m[i];
+            (p[0], p[1], 1e3 * mesh.paraboloid.axial_deviation(p))
+        })
+        .collect();
+    surface_plot(
+        &surface,
+        &format!(
+            "{}: assembled surface error (mm), RMS {:.2e} mm",
+            scene.name, report.verification.rms_mm
+        ),
+        &path("surface-error.png"),
+    )?;
+    write_atomic(
+        &path("model.vtu"),
+        assembly_vtu(network, &report.net.q, &report.verification).as_bytes(),
+    )?;
+    write_atomic(
+        &path("convergence.csv"),
+        convergence_csv(&report.runs).as_bytes(),
+    )?;
+    write_atomic(
+        &path("cables.csv"),
+        cables_csv(network, &report.net, &scene.cables).as_bytes(),
+    )?;
+    write_json(&path("design.json"), report)?;
+    Ok([
+        "design.json",
+        "cables.csv",
+        "convergence.csv",
+        "convergence.png",
+        "convergence.svg",
+        "surface-error.png",
+        "model.vtu",
+    ]
+    .iter()
+    .map(|n| path(n))
+    .collect())
+}

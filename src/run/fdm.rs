@@ -1,0 +1,40 @@
+//! `ringmesh fdm`: forward equilibrium of an interchange-format network.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::fdm::solve_network;
+use crate::network::Network;
+use crate::report::write_json;
+use crate::Error;
+
+/// The output of `ringmesh fdm`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FdmOutput {
+    /// Equilibrium positions, m: n_nodes × 3.
+    pub nodes: Vec<[f64; 3]>,
+    /// Cable lengths, m: n_edges.
+    pub lengths: Vec<f64>,
+    /// Cable tensions, N: n_edges.
+    pub forces: Vec<f64>,
+    /// Support reactions `C_gᵀ Q C x − p_g`, N, in the order of `fixed`.
+    pub reactions: Vec<[f64; 3]>,
+    /// Largest out-of-balance force at a free node, N.
+    pub max_residual: f64,
+}
+
+/// `ringmesh fdm`: forward equilibrium of an interchange-format network.
+pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutput, Error> {
+    let network = Network::read_json(network_path)?;
+    let (_, equilibrium) = solve_network(&network)?;
+    let output = FdmOutput {
+        max_residual: equilibrium.max_residual_n(),
+        nodes: equilibrium.nodes_xyz_m,
+        lengths: equilibrium.edges_lengths_m,
+        forces: equilibrium.edges_forces_n,
+        reactions: equilibrium.reactions_n,
+    };
+    write_json(output_path, &output)?;
+    Ok(output)
+}

@@ -1,0 +1,87 @@
+//! `ringmesh merge`: shards of `front` and `study` joined into the tables and
+//! plots of the unsharded runs.
+
+use std::path::{Path, PathBuf};
+
+use super::front::write_front;
+use super::study::write_study;
+use crate::report::{parse_front_row, parse_study_row, FrontRow};
+use crate::shard::{self, ShardError};
+use crate::study::StudyRow;
+use crate::Error;
+
+/// One sweep joined by `ringmesh merge`.
+#[derive(Debug)]
+pub struct MergeOutcome {
+    /// The command whose shards were joined (`front`, `study`).
+    pub command: String,
+    /// The scene's name.
+    pub scene: String,
+    /// Shards joined.
+    pub shards: usize,
+    /// Rows of the merged table.
+    pub rows: usize,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// `ringmesh merge`: joins the shard CSVs among `paths` (files, or folders
+/// holding `*.shard-I-of-N.csv`) into each sweep's table and plots, exactly
+/// as the unsharded run writes them, in `output_dir` (default
+/// `results/<scene>/`). Shards of different scenes or settings, duplicate or
+/// missing shards are refused before anything is written.
+pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOutcome>, Error> {
+    let files = shard::find_shards(paths)?
+        .iter()
+        .map(|p| shard::read_shard(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let merged = shard::merge(files)?;
+    // Parse every table before writing any.
+    enum Table {
+        Front(Vec<FrontRow>),
+        Study(Vec<StudyRow>),
+    }
+    let mut tables = Vec::new();
+    for m in &merged {
+        let bad = |reason: String| ShardError::Format {
+            path: m.files[0].clone(),
+            reason,
+        };
+        let table = match m.header.command.as_str() {
+            "front" => Table::Front(
+                m.rows
+                    .iter()
+                    .map(|l| parse_front_row(l).map_err(&bad))
+                    .collect::<Result<_, _>>()?,
+            ),
+            "study" => Table::Study(
+                m.rows
+                    .iter()
+                    .map(|l| parse_study_row(l).map_err(&bad))
+                    .collect::<Result<_, _>>()?,
+            ),
+            other => return Err(bad(format!("unknown command `{other}`")).into()),
+        };
+        tables.push(table);
+    }
+    let mut outcomes = Vec::new();
+    for (m, table) in merged.iter().zip(tables) {
+        let dir = output_dir.map_or_else(
+            || Path::new("results").join(&m.header.scene),
+            Path::to_path_buf,
+        );
+        // The plots are drawn from the parsed rows; the table is the shards' text.
+        let written = match table {
+            Table::Front(rows) => write_front(&dir, &m.header.scene, &rows, &m.csv())?,
+            Table::Study(rows) => write_study(&dir, &m.header.scene, &rows, &m.csv())?,
+        };
+        outcomes.push(MergeOutcome {
+            command: m.header.command.clone(),
+            scene: m.header.scene.clone(),
+            shards: m.files.len(),
+            rows: m.rows.len(),
+            written,
+        });
+    }
+    Ok(outcomes)
+}

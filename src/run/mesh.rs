@@ -1,0 +1,40 @@
+//! `ringmesh mesh`: a scene's nets in the interchange format and as VTK.
+
+use std::path::{Path, PathBuf};
+
+use super::default_output_dir;
+use crate::geometry::build_mesh;
+use crate::network::NetworkSummary;
+use crate::report::{network_vtu, write_atomic, write_json};
+use crate::scene::Scene;
+use crate::Error;
+
+/// What `ringmesh mesh` made.
+#[derive(Debug, Clone)]
+pub struct MeshOutcome {
+    /// The scene's name.
+    pub scene: String,
+    /// Counts and extreme lengths.
+    pub summary: NetworkSummary,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// `ringmesh mesh`: builds the nets of a scene and writes `network.json` (the
+/// interchange format, design positions, initial q) and `mesh.vtu`.
+pub fn mesh(scene_path: &Path, output_dir: Option<&Path>) -> Result<MeshOutcome, Error> {
+    let scene = Scene::read(scene_path)?;
+    let mesh = build_mesh(&scene)?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let summary = mesh.network.summary();
+    let vtu = network_vtu(&mesh.network, None, None);
+    let network_path = dir.join("network.json");
+    let vtu_path = dir.join("mesh.vtu");
+    write_json(&network_path, &mesh.network)?;
+    write_atomic(&vtu_path, vtu.as_bytes())?;
+    Ok(MeshOutcome {
+        scene: scene.name,
+        summary,
+        written: vec![network_path, vtu_path],
+    })
+}

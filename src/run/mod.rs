@@ -1,0 +1,83 @@
+//! One file per CLI subcommand: read the inputs, call the library, write the
+//! outputs (atomically, and only once everything is computed), and return
+//! what the command prints. `main.rs` only parses arguments and calls these;
+//! the pipelines themselves live in the library ([`crate::design::run`],
+//! [`crate::study::run_study`], …).
+
+mod cantilever;
+mod design;
+mod fdm;
+mod frame;
+mod front;
+mod merge;
+mod mesh;
+mod optimize;
+mod study;
+mod truss;
+mod uniformity;
+
+use std::path::{Path, PathBuf};
+
+pub use cantilever::{cantilever, CantileverTable, CantileverTableRow};
+pub use design::{design, DesignOutcome};
+pub use fdm::{fdm, FdmOutput};
+pub use frame::{
+    default_frame_output, frame, FrameCounts, FrameNodeOutput, FrameOutput, FrameReaction,
+};
+pub use front::front;
+pub use merge::{merge, MergeOutcome};
+pub use mesh::{mesh, MeshOutcome};
+pub use optimize::optimize;
+pub use study::{study, StudyOptions, StudyOutcome, STUDY_STEM};
+pub use truss::truss;
+pub use uniformity::{uniformity, UniformityOutput};
+
+use crate::report::write_atomic;
+use crate::scene::Scene;
+use crate::shard::{self, Shard, ShardHeader};
+use crate::Error;
+
+/// Progress of a long command; the CLI attaches a progress bar, the library
+/// never prints.
+pub trait Progress: Sync {
+    /// The command will report `total` steps.
+    fn start(&self, _total: usize) {}
+    /// One step finished.
+    fn step(&self, _message: &str) {}
+}
+
+/// A [`Progress`] that ignores everything.
+pub struct Silent;
+
+impl Progress for Silent {}
+
+/// Where a scene's results go by default: `results/<scene name>/`.
+pub fn default_output_dir(scene: &Scene) -> PathBuf {
+    Path::new("results").join(&scene.name)
+}
+
+/// Writes a shard's CSV, `<stem>.shard-I-of-N.csv`, in `dir`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn write_shard(
+    dir: &Path,
+    stem: &str,
+    command: &str,
+    scene: &Scene,
+    shard: Shard,
+    points: usize,
+    settings: serde_json::Value,
+    columns: &str,
+    rows: &[(usize, String)],
+) -> Result<PathBuf, Error> {
+    let header = ShardHeader {
+        command: command.to_string(),
+        scene: scene.name.clone(),
+        shard,
+        points,
+        settings,
+        scene_file: serde_json::to_value(scene).expect("a scene serialises"),
+    };
+    let path = dir.join(shard.file_name(stem));
+    write_atomic(&path, shard::shard_csv(&header, columns, rows).as_bytes())?;
+    Ok(path)
+}

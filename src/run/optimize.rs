@@ -1,0 +1,45 @@
+//! `ringmesh optimize`: one uniformity design of a scene's front net for its
+//! theoretical boundary (no truss).
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::default_output_dir;
+use crate::design::scene_problem;
+use crate::report::{cables_csv, write_atomic, write_json};
+use crate::scene::Scene;
+use crate::uniformity::{Design, SolverKind};
+use crate::Error;
+
+/// `design.json`: the scene's name and the design.
+#[derive(Serialize)]
+struct DesignFile<'a> {
+    scene: &'a str,
+    #[serde(flatten)]
+    design: &'a Design,
+}
+
+/// `ringmesh optimize`: one design for the theoretical boundary, written as
+/// `design.json` and `cables.csv` (with cut lengths).
+pub fn optimize(
+    scene_path: &Path,
+    solver: SolverKind,
+    output_dir: Option<&Path>,
+) -> Result<(Design, Vec<PathBuf>), Error> {
+    let scene = Scene::read(scene_path)?;
+    let (mesh, problem) = scene_problem(&scene)?;
+    let design = solver.build(None).solve(&problem)?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let csv = cables_csv(&mesh.network, &design, &scene.cables);
+    let (json_path, csv_path) = (dir.join("design.json"), dir.join("cables.csv"));
+    write_json(
+        &json_path,
+        &DesignFile {
+            scene: &scene.name,
+            design: &design,
+        },
+    )?;
+    write_atomic(&csv_path, csv.as_bytes())?;
+    Ok((design, vec![json_path, csv_path]))
+}

@@ -1,0 +1,162 @@
+//! `ringmesh study`: what accuracy costs in time ([`crate::study`]), as a
+//! table and plots (or one shard's points).
+
+use std::path::{Path, PathBuf};
+
+use super::{default_output_dir, write_shard, Progress};
+use crate::report::{study_csv, study_plot, study_row, write_atomic, STUDY_COLUMNS};
+use crate::scene::{Scene, TrussModel};
+use crate::shard::Shard;
+use crate::study::{self, Knob, StudyRow, StudySettings};
+use crate::uniformity::SolverKind;
+use crate::Error;
+
+/// Choices of `ringmesh study`, resolved by the CLI; `None` keeps the
+/// default sweep of [`StudySettings::for_scene`].
+#[derive(Debug, Clone)]
+pub struct StudyOptions {
+    /// The knobs swept (the others are left out).
+    pub knobs: Vec<Knob>,
+    /// Outer-loop tolerances, m.
+    pub tolerances_m: Option<Vec<f64>>,
+    /// Elements per truss rod.
+    pub elements_per_rod: Option<Vec<usize>>,
+    /// Front-net rings.
+    pub rings: Option<Vec<usize>>,
+    /// Truss models.
+    pub truss_models: Option<Vec<TrussModel>>,
+    /// Uniformity solvers.
+    pub solvers: Option<Vec<SolverKind>>,
+    /// Most outer iterations of a run.
+    pub max_iterations: Option<usize>,
+    /// Points run at once (1: one after the other, each timed alone).
+    pub jobs: usize,
+}
+
+impl Default for StudyOptions {
+    fn default() -> Self {
+        StudyOptions {
+            knobs: Knob::SWEPT.to_vec(),
+            tolerances_m: None,
+            elements_per_rod: None,
+            rings: None,
+            truss_models: None,
+            solvers: None,
+            max_iterations: None,
+            jobs: 1,
+        }
+    }
+}
+
+impl StudyOptions {
+    /// The study's settings for `scene`.
+    pub fn settings(&self, scene: &Scene) -> StudySettings {
+        let mut s = StudySettings::for_scene(scene);
+        if let Some(v) = &self.tolerances_m {
+            s.tolerances_m.clone_from(v);
+        }
+        if let Some(v) = &self.elements_per_rod {
+            s.elements_per_rod.clone_from(v);
+        }
+        if let Some(v) = &self.rings {
+            s.rings.clone_from(v);
+        }
+        if let Some(v) = &self.truss_models {
+            s.truss_models.clone_from(v);
+        }
+        if let Some(v) = &self.solvers {
+            s.solvers.clone_from(v);
+        }
+        if let Some(n) = self.max_iterations {
+            s.max_iterations = n;
+        }
+        s.only(&self.knobs)
+    }
+}
+
+/// What `ringmesh study` made.
+#[derive(Debug)]
+pub struct StudyOutcome {
+    /// The scene's name.
+    pub scene: String,
+    /// `(point index, row)` of the points run, in sweep order.
+    pub rows: Vec<(usize, StudyRow)>,
+    /// Points of the whole sweep.
+    pub points: usize,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// The name of the study's table and plots.
+pub const STUDY_STEM: &str = "accuracy-vs-time";
+
+/// `ringmesh study`: what accuracy costs in time ([`crate::study`]). Writes
+/// `accuracy-vs-time.csv`, `.png` and `.svg`; with a `shard`, only that
+/// shard's points (and the reference, run to judge them), written as
+/// `accuracy-vs-time.shard-I-of-N.csv`.
+pub fn study(
+    scene_path: &Path,
+    options: &StudyOptions,
+    output_dir: Option<&Path>,
+    shard: Option<Shard>,
+    progress: &dyn Progress,
+) -> Result<StudyOutcome, Error> {
+    let scene = Scene::read(scene_path)?;
+    let settings = options.settings(&scene);
+    settings.validate()?;
+    let total = study::points(&scene, &settings).len();
+    let part = shard.unwrap_or(Shard::WHOLE);
+    let runs = part.points(total).len() + usize::from(!part.includes(0));
+    progress.start(runs);
+    let rows = study::run_study(&scene, &settings, part, options.jobs, &|r: &StudyRow| {
+        progress.step(&format!("{} {}", r.knob.name(), r.value));
+    })?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let written = match shard {
+        Some(shard) => {
+            let lines: Vec<(usize, String)> =
+                rows.iter().map(|(k, r)| (*k, study_row(r))).collect();
+            let settings = serde_json::to_value(&settings).expect("settings serialise");
+            vec![write_shard(
+                &dir,
+                STUDY_STEM,
+                "study",
+                &scene,
+                shard,
+                total,
+                settings,
+                STUDY_COLUMNS,
+                &lines,
+            )?]
+        }
+        None => {
+            let table: Vec<StudyRow> = rows.iter().map(|(_, r)| r.clone()).collect();
+            write_study(&dir, &scene.name, &table, &study_csv(&table))?
+        }
+    };
+    Ok(StudyOutcome {
+        scene: scene.name,
+        rows,
+        points: total,
+        written,
+    })
+}
+
+/// `accuracy-vs-time.csv` (the table `csv`), `.png`, `.svg` (drawn from `rows`).
+pub(crate) fn write_study(
+    dir: &Path,
+    scene: &str,
+    rows: &[StudyRow],
+    csv: &str,
+) -> Result<Vec<PathBuf>, Error> {
+    let paths = [
+        dir.join(format!("{STUDY_STEM}.csv")),
+        dir.join(format!("{STUDY_STEM}.png")),
+        dir.join(format!("{STUDY_STEM}.svg")),
+    ];
+    let title =
+        format!("{scene}: what accuracy costs in time (designs as built on the reference truss)");
+    study_plot(rows, &title, &paths[1], &paths[2])?;
+    write_atomic(&paths[0], csv.as_bytes())?;
+    Ok(paths.to_vec())
+}

@@ -1,0 +1,117 @@
+//! `ringmesh uniformity`: the uniformity problem on an interchange-format
+//! network whose node positions are the prescribed geometry.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::algebra::norm3;
+use crate::network::Network;
+use crate::report::write_json;
+use crate::uniformity::{
+    SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem, UniformitySet,
+};
+use crate::Error;
+
+/// The output of `ringmesh uniformity`.
+#[derive(Debug, Clone, Serialize)]
+pub struct UniformityOutput {
+    /// Force densities, N/m.
+    pub q: Vec<f64>,
+    /// Tensions, N.
+    pub tensions: Vec<f64>,
+    /// `Tmax/Tmin` over the uniformity groups.
+    pub ratio: f64,
+    /// Out-of-balance force of `q` on the prescribed geometry, N.
+    pub max_residual: f64,
+    /// The solver.
+    pub solver: String,
+    /// How it stopped.
+    pub termination: Termination,
+    /// Its iterations.
+    pub iterations: usize,
+    /// Wall time, s.
+    pub time_s: f64,
+}
+
+/// `ringmesh uniformity`: the uniformity problem on a network whose node
+/// positions are the prescribed geometry. `groups`: the uniformity set is their
+/// union (default `front` when the file has groups, else every cable);
+/// `mean_tension_n`: its target (default: the mean tension of the file's `q`);
+/// `max_force_density_n_per_m`: the bound `[q]` on every cable (may be infinite).
+pub fn uniformity(
+    network_path: &Path,
+    solver: SolverKind,
+    groups: Option<&[String]>,
+    mean_tension_n: Option<f64>,
+    max_force_density_n_per_m: f64,
+    output_path: &Path,
+) -> Result<UniformityOutput, Error> {
+    let network = Network::read_json(network_path)?;
+    let default_groups = vec!["front".to_string()];
+    let groups: Vec<String> = match (groups, &network.groups) {
+        (Some(g), _) => g.to_vec(),
+        (None, Some(_)) => default_groups,
+        (None, None) => Vec::new(),
+    };
+    let edges: Vec<usize> = (0..network.n_edges())
+        .filter(|&k| groups.is_empty() || groups.iter().any(|g| g == network.group_of(k)))
+        .collect();
+    if let Some(missing) = groups
+        .iter()
+        .find(|g| !(0..network.n_edges()).any(|k| network.group_of(k) == g.as_str()))
+    {
+        return Err(UniformityError::Invalid(format!(
+            "--groups: no cable of the network is in group `{missing}`"
+        ))
+        .into());
+    }
+    let lengths: Vec<f64> = network.edges_vectors().into_iter().map(norm3).collect();
+    let mean = match mean_tension_n {
+        Some(t) => t,
+        None => {
+            edges
+                .iter()
+                .map(|&k| network.q[k] * lengths[k])
+                .sum::<f64>()
+                / edges.len().max(1) as f64
+        }
+    };
+    let name = if groups.is_empty() {
+        "all".to_string()
+    } else {
+        groups.join("+")
+    };
+    let fixed = network.fixed_mask();
+    let surface = (0..network.n_nodes()).filter(|&i| !fixed[i]).collect();
+    let set = UniformitySet {
+        name,
+        edges,
+        mean_tension_n: mean,
+    };
+    let problem = UniformityProblem::new(
+        network,
+        vec![set],
+        surface,
+        SurfaceTarget::Prescribed,
+        max_force_density_n_per_m,
+    )?;
+    let design = solver.build(None).solve(&problem)?;
+    let output = UniformityOutput {
+        ratio: design.ratio,
+        max_residual: design.max_residual_n,
+        tensions: problem
+            .lengths_m()
+            .iter()
+            .zip(&design.q)
+            .map(|(l, q)| l * q)
+            .collect(),
+        q: design.q,
+        solver: design.solver,
+        termination: design.termination,
+        iterations: design.iterations,
+        time_s: design.time_s,
+    };
+    write_json(output_path, &output)?;
+    Ok(output)
+}
