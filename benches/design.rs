@@ -128,6 +128,7 @@ fn bench_design(c: &mut Criterion) {
                 verify(
                     &f.scene,
                     &f.nets.mesh,
+                    &f.nets.effects,
                     network,
                     &outcome.design,
                     AssemblyTruss::Flexible,

@@ -26,6 +26,7 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::Vector3;
+use ringmesh::effects::SceneEffects;
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::{
@@ -126,7 +127,8 @@ fn ring_fixture(scene: &Scene, elements_per_rod: usize, settings: &StaticSetting
     let mesh = build_mesh(&scene).expect("the shipped scene builds");
     // The net pulls on its supports with −(reactions), as `ringmesh truss`.
     let (_, eq) = solve_network(&mesh.network).expect("the net solves");
-    let ring = RingTruss::new(&scene, &mesh.truss).expect("the ring truss builds");
+    let ring = RingTruss::new(&scene, &mesh.truss, &SceneEffects::of(&scene))
+        .expect("the ring truss builds");
     let loads = ring
         .attachments
         .iter()

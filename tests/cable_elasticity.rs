@@ -7,6 +7,7 @@ use std::path::Path;
 
 use ringmesh::design::scene_problem;
 use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
+use ringmesh::effects::SceneEffects;
 use ringmesh::geometry::ReflectorMesh;
 use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{layout_points, oracle};
@@ -35,7 +36,15 @@ fn assemble(
     design: &Design,
     truss: AssemblyTruss,
 ) -> Verification {
-    let v = verify(scene, mesh, network, design, truss).unwrap();
+    let v = verify(
+        scene,
+        mesh,
+        &SceneEffects::of(scene),
+        network,
+        design,
+        truss,
+    )
+    .unwrap();
     let expected = if scene.effects.cable_elasticity {
         (CableModel::Elastic, 1.0)
     } else {
@@ -115,7 +124,13 @@ fn inextensible_rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
 fn the_design_for_the_deforming_truss_survives_inextensible_assembly() {
     let (scene, mesh, nets) = small_hex();
     let solver = SolverKind::Lp.build(None);
-    let mut truss = oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+    let mut truss = oracle(
+        TrussModel::Exact,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     let settings = LoopSettings {
         relaxation: RelaxationKind::Anderson,
         tolerance_m: 1e-7,

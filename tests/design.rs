@@ -5,6 +5,7 @@ use std::path::Path;
 
 use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
 use ringmesh::design::{scene_problem, DesignSettings};
+use ringmesh::effects::SceneEffects;
 use ringmesh::geometry::ReflectorMesh;
 use ringmesh::run::design;
 use ringmesh::scene::{Scene, TrussModel};
@@ -37,7 +38,13 @@ fn settings(relaxation: RelaxationKind) -> LoopSettings {
 fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
     let (scene, mesh, nets) = small_hex();
     let solver = SolverKind::Lp.build(None);
-    let mut truss = oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+    let mut truss = oracle(
+        TrussModel::Exact,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     let outcome = design_loop(
         &nets,
         solver.as_ref(),
@@ -51,6 +58,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
     let designed = verify(
         &scene,
         &mesh,
+        &SceneEffects::of(&scene),
         outcome.problem.network(),
         &outcome.design,
         AssemblyTruss::Flexible,
@@ -72,6 +80,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
     let conventional = verify(
         &scene,
         &mesh,
+        &SceneEffects::of(&scene),
         rigid.problem.network(),
         &rigid.design,
         AssemblyTruss::Flexible,
@@ -89,7 +98,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
     // The truss carries the design's pull with a margin (DESIGN §9): stable
     // to the end of the search, its lowest stiffness falling all the way.
     let margin = limit_margin(
-        RingTruss::new(&scene, &mesh.truss).unwrap(),
+        RingTruss::new(&scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap(),
         &outcome.design.pull_n(),
     )
     .unwrap();
@@ -129,7 +138,7 @@ fn a_design_past_the_truss_limit_load_is_refused() {
         .design(solver.as_ref(), &layout_points(&mesh.truss))
         .unwrap();
     let margin = limit_margin(
-        RingTruss::new(&scene, &mesh.truss).unwrap(),
+        RingTruss::new(&scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap(),
         &first.design.pull_n(),
     )
     .unwrap();
@@ -168,6 +177,7 @@ fn rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
     let v = verify(
         &scene,
         &mesh,
+        &SceneEffects::of(&scene),
         design.problem.network(),
         &design.design,
         AssemblyTruss::Rigid,
@@ -185,7 +195,13 @@ fn rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
 #[test]
 fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
     let (scene, mesh, nets) = small_hex();
-    let mut truss = oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+    let mut truss = oracle(
+        TrussModel::Exact,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     for kind in [SolverKind::Lp, SolverKind::LeastSquares] {
         let solver = kind.build(None);
         let c0 = layout_points(&mesh.truss);
@@ -214,7 +230,13 @@ fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
 fn rigid_truss_loop_stops_after_one_design() {
     let (scene, mesh, nets) = small_hex();
     let solver = SolverKind::Lp.build(None);
-    let mut truss = oracle(TrussModel::Rigid, &scene, &mesh.truss).unwrap();
+    let mut truss = oracle(
+        TrussModel::Rigid,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     for relaxation in [
         RelaxationKind::Paper,
         RelaxationKind::Aitken,
@@ -241,7 +263,13 @@ fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
     let (scene, mesh, nets) = small_hex();
     let solver = SolverKind::Lp.build(None);
     let iterations = |relaxation| {
-        let mut truss = oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+        let mut truss = oracle(
+            TrussModel::Exact,
+            &scene,
+            &mesh.truss,
+            &SceneEffects::of(&scene),
+        )
+        .unwrap();
         let outcome = design_loop(
             &nets,
             solver.as_ref(),

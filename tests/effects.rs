@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use ringmesh::design::TiedNets;
 use ringmesh::design::{scene_problem, DesignSettings};
+use ringmesh::effects::SceneEffects;
 use ringmesh::effects::{self, CableSelfWeight, EffectKind};
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::{build_mesh, ReflectorMesh};
@@ -75,7 +76,7 @@ fn tied_design(scene: &Scene, mesh: &ReflectorMesh) -> Design {
     let (_, problem) = scene_problem(scene).unwrap();
     let nets = TiedNets::new(mesh, problem)
         .unwrap()
-        .with_cable_self_weight(CableSelfWeight::of(scene));
+        .with_effects(&SceneEffects::of(scene));
     nets.design(
         SolverKind::Bisection.build(None).as_ref(),
         &layout_points(&mesh.truss),
@@ -208,8 +209,8 @@ fn truss_self_weight_totals_its_mass() {
     let mut scene = scene_under(Some([0.0, 0.0, -1.0]));
     scene.truss.hinge_mass_kg = 0.75;
     let mesh = build_mesh(&scene).unwrap();
-    let truss = RingTruss::new(&scene, &mesh.truss).unwrap();
-    let total: f64 = truss.self_weight.iter().map(|l| l.force_n.z).sum();
+    let truss = RingTruss::new(&scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap();
+    let total: f64 = truss.dead_loads.iter().map(|l| l.force_n.z).sum();
     let t = &scene.truss;
     let area = std::f64::consts::PI
         * (t.tube_outer_diameter_m.powi(2) - t.tube_inner_diameter_m.powi(2))

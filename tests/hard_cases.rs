@@ -13,6 +13,7 @@ use std::time::Instant;
 use nalgebra::{UnitQuaternion, Vector3};
 use ringmesh::design::scene_problem;
 use ringmesh::design::TiedNets;
+use ringmesh::effects::SceneEffects;
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::rotation::exp;
@@ -309,7 +310,7 @@ fn thin_tubes_keep_newton_quadratic() {
     let shortest_rod = s.truss.height_m;
     let slenderness = 16.0 * shortest_rod * shortest_rod / (d_o * d_o + d_i * d_i);
     assert!(slenderness >= 1e8, "EA L²/EI = {slenderness:e}");
-    let ring = RingTruss::new(&s, &mesh.truss).unwrap();
+    let ring = RingTruss::new(&s, &mesh.truss, &SceneEffects::of(&s)).unwrap();
     let supported: Vec<usize> = ring
         .supports
         .iter()
@@ -430,7 +431,7 @@ fn ring_truss_past_its_limit_load_is_followed_or_reported() {
     let s = scene("small-hex");
     let mesh = build_mesh(&s).unwrap();
     let pull = scaled(&net_pull(&mesh), 10.0);
-    let ring = RingTruss::new(&s, &mesh.truss).unwrap();
+    let ring = RingTruss::new(&s, &mesh.truss, &SceneEffects::of(&s)).unwrap();
     let mut solver = StaticSolver::new(ring.model.clone()).unwrap();
     solver
         .model_mut()
@@ -507,7 +508,8 @@ fn ring_truss_past_its_limit_load_is_followed_or_reported() {
     assert!((5.5..7.5).contains(&limit), "limit {limit} × the pull");
 
     // The oracle the design loop queries says so, with the number.
-    let mut exact = truss::oracle(TrussModel::Exact, &s, &mesh.truss).unwrap();
+    let mut exact =
+        truss::oracle(TrussModel::Exact, &s, &mesh.truss, &SceneEffects::of(&s)).unwrap();
     let error = exact.respond(&pull).unwrap_err();
     let TrussError::NoEquilibrium {
         termination: StaticTermination::LimitPoint { .. },
@@ -586,7 +588,15 @@ fn slack_cables_in_verification_are_reported_and_carry_nothing() {
         .collect();
     let scattered: Vec<usize> = front.iter().copied().step_by(9).collect();
     let slackened = design_with_cut(&made.design, &scattered, 1.05, ea);
-    let v = verify(&s, &mesh, network, &slackened, AssemblyTruss::Flexible).unwrap();
+    let v = verify(
+        &s,
+        &mesh,
+        &SceneEffects::of(&s),
+        network,
+        &slackened,
+        AssemblyTruss::Flexible,
+    )
+    .unwrap();
     assert_eq!(v.slack_cables, scattered, "slack cables reported");
     for &k in &scattered {
         // The slack regularisation: 1e-9 EA × the 5 % shortfall at most.
@@ -596,6 +606,7 @@ fn slack_cables_in_verification_are_reported_and_carry_nothing() {
     let reference = verify(
         &s,
         &mesh,
+        &SceneEffects::of(&s),
         &reduced_net,
         &reduced_design,
         AssemblyTruss::Flexible,
@@ -618,7 +629,15 @@ fn slack_cables_in_verification_are_reported_and_carry_nothing() {
         .collect();
     assert_eq!(centre.len(), 7);
     let floating = design_with_cut(&made.design, &centre, 1.05, ea);
-    let f = verify(&s, &mesh, network, &floating, AssemblyTruss::Flexible).unwrap();
+    let f = verify(
+        &s,
+        &mesh,
+        &SceneEffects::of(&s),
+        network,
+        &floating,
+        AssemblyTruss::Flexible,
+    )
+    .unwrap();
     assert_eq!(f.slack_cables, centre);
     assert!(f.nodes_xyz_m.iter().flatten().all(|x| x.is_finite()));
     let taut = f

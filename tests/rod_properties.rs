@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use ringmesh::effects::SceneEffects;
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::{build_mesh, ReflectorMesh};
 use ringmesh::mechanics::Section;
@@ -61,7 +62,7 @@ fn scaled_table(scene: &Scene, kinds: &[RodKind], factors: [f64; 4]) -> String {
 /// Attachment displacements, m: 2N × 3.
 fn displacements(scene: &Scene, model: TrussModel, loads: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let mesh = build_mesh(scene).unwrap();
-    let mut oracle = truss::oracle(model, scene, &mesh.truss).unwrap();
+    let mut oracle = truss::oracle(model, scene, &mesh.truss, &SceneEffects::of(scene)).unwrap();
     let moved = oracle.respond(loads).unwrap().positions_m;
     moved
         .iter()
@@ -221,7 +222,7 @@ fn rods_are_named_by_bay_in_build_order() {
     let mesh = build_mesh(&scene).unwrap();
     let layout = &mesh.truss;
     let n = layout.bays();
-    let ring = RingTruss::new(&scene, layout).unwrap();
+    let ring = RingTruss::new(&scene, layout, &SceneEffects::of(&scene)).unwrap();
     let rods = ring.model.rods();
     assert_eq!(rods.len(), 5 * n);
     let at = |node: usize| {

@@ -3,6 +3,7 @@
 //! loads and part under the paper's; bad loads are refused.
 
 use nalgebra::Vector3;
+use ringmesh::effects::SceneEffects;
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::{build_mesh, ReflectorMesh};
 use ringmesh::mechanics::{NodalLoad, StaticSettings, StaticSolver};
@@ -42,7 +43,7 @@ fn isostatic_ring_truss_under_self_equilibrated_pull_has_no_reactions() {
     let scene = scene("small-hex");
     let mesh = build_mesh(&scene).unwrap();
     let pull = net_pull(&mesh);
-    let ring = RingTruss::new(&scene, &mesh.truss).unwrap();
+    let ring = RingTruss::new(&scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap();
     let loads: Vec<NodalLoad> = ring
         .attachments
         .iter()
@@ -118,8 +119,20 @@ fn linear_and_exact_trusses_agree_under_tiny_loads_and_part_under_the_papers() {
         .chain(&mesh.truss.bottom_m)
         .copied()
         .collect();
-    let mut linear = truss::oracle(TrussModel::Linear, &scene, &mesh.truss).unwrap();
-    let mut exact = truss::oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+    let mut linear = truss::oracle(
+        TrussModel::Linear,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
+    let mut exact = truss::oracle(
+        TrussModel::Exact,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     let relative_difference =
         |s: f64,
          linear: &mut Box<dyn truss::TrussOracle>,
@@ -161,7 +174,8 @@ fn rigid_truss_never_moves_and_every_model_refuses_bad_loads() {
     let mesh = build_mesh(&scene).unwrap();
     let pull = net_pull(&mesh);
     for model in [TrussModel::Rigid, TrussModel::Linear, TrussModel::Exact] {
-        let mut oracle = truss::oracle(model, &scene, &mesh.truss).unwrap();
+        let mut oracle =
+            truss::oracle(model, &scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap();
         let short = &pull[1..];
         assert!(
             matches!(oracle.respond(short), Err(TrussError::LoadCount { .. })),
@@ -177,7 +191,13 @@ fn rigid_truss_never_moves_and_every_model_refuses_bad_loads() {
             "{model:?}"
         );
     }
-    let mut rigid = truss::oracle(TrussModel::Rigid, &scene, &mesh.truss).unwrap();
+    let mut rigid = truss::oracle(
+        TrussModel::Rigid,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     let r = rigid.respond(&pull).unwrap();
     assert_eq!(r.positions_m, rigid.attachments());
 }
@@ -187,10 +207,22 @@ fn exact_truss_warm_start_reproduces_the_cold_solution() {
     let scene = scene("small-hex");
     let mesh = build_mesh(&scene).unwrap();
     let pull = net_pull(&mesh);
-    let mut warm = truss::oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+    let mut warm = truss::oracle(
+        TrussModel::Exact,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     warm.respond(&scaled(&pull, 0.5)).unwrap();
     let from_warm = warm.respond(&pull).unwrap().positions_m;
-    let mut cold = truss::oracle(TrussModel::Exact, &scene, &mesh.truss).unwrap();
+    let mut cold = truss::oracle(
+        TrussModel::Exact,
+        &scene,
+        &mesh.truss,
+        &SceneEffects::of(&scene),
+    )
+    .unwrap();
     let from_cold = cold.respond(&pull).unwrap().positions_m;
     let d = max_displacement(
         &from_cold,

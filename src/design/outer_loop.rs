@@ -118,6 +118,9 @@ pub struct LoopOutcome {
     /// The design of iteration 0, for the undeformed attachment points: the
     /// conventional (rigid-truss) design.
     pub initial: TiedDesign,
+    /// Whether the loop's truss deforms ([`TrussOracle::deforms`]): its design
+    /// is then verified on the flexible truss.
+    pub truss_deforms: bool,
     /// The final boundary `C_k` (attachment order), m.
     pub boundary_m: Vec<[f64; 3]>,
     /// The truss's attachment points under that design's pull, `G(C_k)`, m.
@@ -238,6 +241,7 @@ pub fn design_loop_with(
                 design: tied.design,
                 problem: tied.problem,
                 initial,
+                truss_deforms: oracle.deforms(),
                 boundary_m: unflatten(&x),
                 deformed_m: response.positions_m,
                 history,

@@ -13,6 +13,7 @@ use super::outer_loop::{IterationRecord, LoopSettings, LoopTermination};
 use super::relaxation::RelaxationKind;
 use super::scene_nets::SceneNets;
 use super::DesignError;
+use crate::effects::SceneEffects;
 use crate::geometry::ReflectorMesh;
 use crate::mechanics::LimitSearch;
 use crate::network::Network;
@@ -195,26 +196,29 @@ pub fn run(
             ) => {
                 let first =
                     nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
-                return Err(match design_margin(scene, mesh, &first.design) {
-                    Err(past) => past,
-                    Ok(_) => e,
-                });
+                return Err(
+                    match design_margin(scene, mesh, &scene_nets.effects, &first.design) {
+                        Err(past) => past,
+                        Ok(_) => e,
+                    },
+                );
             }
             Err(e) => return Err(e),
         }
     }
     let outcome = outcome.expect("at least one relaxation");
-    let assembly = if model == TrussModel::Rigid {
-        AssemblyTruss::Rigid
-    } else {
+    let effects = &scene_nets.effects;
+    let assembly = if outcome.truss_deforms {
         AssemblyTruss::Flexible
+    } else {
+        AssemblyTruss::Rigid
     };
     let limit_margin = match assembly {
         AssemblyTruss::Rigid => None,
-        AssemblyTruss::Flexible => Some(design_margin(scene, mesh, &outcome.design)?),
+        AssemblyTruss::Flexible => Some(design_margin(scene, mesh, effects, &outcome.design)?),
     };
     let network = outcome.problem.network().clone();
-    let verification = verify(scene, mesh, &network, &outcome.design, assembly)?;
+    let verification = verify(scene, mesh, effects, &network, &outcome.design, assembly)?;
     // The conventional design is the loop's iteration 0: the design for the
     // undeformed attachment points.
     let conventional = match assembly {
@@ -222,6 +226,7 @@ pub fn run(
         AssemblyTruss::Flexible => Some(verify(
             scene,
             mesh,
+            effects,
             outcome.initial.problem.network(),
             &outcome.initial.design,
             AssemblyTruss::Flexible,
@@ -252,7 +257,8 @@ pub fn run(
     })
 }
 
-/// The margin of `scene`'s truss to its limit load under `design`'s pull.
+/// The margin of `scene`'s truss (with `effects`) to its limit load under
+/// `design`'s pull.
 ///
 /// # Errors
 /// A truss that cannot be built, or a pull it cannot carry stably
@@ -260,11 +266,12 @@ pub fn run(
 pub fn design_margin(
     scene: &Scene,
     mesh: &ReflectorMesh,
+    effects: &SceneEffects,
     design: &Design,
 ) -> Result<LimitSearch, Error> {
     // The net pulls on its supports with −F_g.
     let pull = design.pull_n();
-    let truss = RingTruss::new(scene, &mesh.truss).map_err(TrussError::from)?;
+    let truss = RingTruss::new(scene, &mesh.truss, effects).map_err(TrussError::from)?;
     let margin = crate::truss::limit_margin(truss, &pull)?;
     match margin.unstable_from {
         Some(unstable_from) if margin.stable_to < 1.0 => Err(TrussError::PastLimitLoad {

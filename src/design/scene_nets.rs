@@ -4,18 +4,27 @@
 
 use super::outer_loop::{design_loop, IterationRecord, LoopOutcome, LoopSettings};
 use super::tied_nets::TiedNets;
-use crate::effects::CableSelfWeight;
+use crate::effects::SceneEffects;
 use crate::geometry::{build_mesh, ReflectorMesh};
 use crate::scene::{Scene, TrussModel};
 use crate::uniformity::{UniformityProblem, UniformitySolver};
 use crate::Error;
 
 /// The uniformity problem of a scene's front net for its theoretical boundary,
-/// under the cables' self weight when the scene asks for gravity.
+/// under the nodal loads of the effects the scene asks for (the cables' self
+/// weight under gravity).
 ///
 /// # Errors
 /// A mesh or uniformity problem that cannot be built.
 pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem), Error> {
+    problem_with(scene, &SceneEffects::of(scene))
+}
+
+/// [`scene_problem`] with the effects already built.
+fn problem_with(
+    scene: &Scene,
+    effects: &SceneEffects,
+) -> Result<(ReflectorMesh, UniformityProblem), Error> {
     let mesh = build_mesh(scene)?;
     let mut problem = UniformityProblem::from_mesh(
         &mesh,
@@ -23,9 +32,8 @@ pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem)
         scene.cables.max_force_density_n_per_m,
     )?;
     problem.min_tension_fraction = scene.uniformity.min_tension_fraction;
-    let weights =
-        CableSelfWeight::of(scene).map(|w| w.nodal_loads(&mesh.network.nodes, &mesh.network.edges));
-    Ok((mesh, problem.with_loads(weights)?))
+    let loads = effects.net_loads_n(&mesh.network.nodes, &mesh.network.edges);
+    Ok((mesh, problem.with_loads(loads)?))
 }
 
 /// A scene's nets ready for the outer loop: the mesh and its two-stage
@@ -35,18 +43,32 @@ pub struct SceneNets {
     pub mesh: ReflectorMesh,
     /// The two-stage design problem on them.
     pub nets: TiedNets,
+    /// The effects the scene asks for, built once for every stage.
+    pub effects: SceneEffects,
 }
 
 impl SceneNets {
-    /// Builds the mesh and the design problem of `scene`.
+    /// Builds the effects, the mesh and the design problem of `scene`.
     ///
     /// # Errors
     /// An invalid mesh or uniformity problem.
     pub fn new(scene: &Scene) -> Result<SceneNets, Error> {
-        let (mesh, problem) = scene_problem(scene)?;
-        let nets =
-            TiedNets::new(&mesh, problem)?.with_cable_self_weight(CableSelfWeight::of(scene));
-        Ok(SceneNets { mesh, nets })
+        SceneNets::with_effects(scene, SceneEffects::of(scene))
+    }
+
+    /// Builds the mesh and the design problem of `scene` under `effects`
+    /// (the scene's own, or more: see [`SceneEffects::with`]).
+    ///
+    /// # Errors
+    /// An invalid mesh or uniformity problem.
+    pub fn with_effects(scene: &Scene, effects: SceneEffects) -> Result<SceneNets, Error> {
+        let (mesh, problem) = problem_with(scene, &effects)?;
+        let nets = TiedNets::new(&mesh, problem)?.with_effects(&effects);
+        Ok(SceneNets {
+            mesh,
+            nets,
+            effects,
+        })
     }
 
     /// One run of the outer loop (net design ⇄ truss response) with a fresh
@@ -63,7 +85,7 @@ impl SceneNets {
         settings: &LoopSettings,
         observe: &mut dyn FnMut(&IterationRecord),
     ) -> Result<LoopOutcome, Error> {
-        let mut oracle = crate::truss::oracle(model, scene, &self.mesh.truss)?;
+        let mut oracle = crate::truss::oracle(model, scene, &self.mesh.truss, &self.effects)?;
         Ok(design_loop(
             &self.nets,
             solver,

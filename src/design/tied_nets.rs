@@ -41,7 +41,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
-use crate::effects::CableSelfWeight;
+use crate::effects::SceneEffects;
 use crate::fdm::FdmStructure;
 use crate::geometry::ReflectorMesh;
 use crate::network::{CableGroup, Network};
@@ -89,8 +89,8 @@ pub struct TiedNets {
     ties: Vec<(usize, usize, usize)>,
     /// The mesh: its plan grid is rebuilt on the deformed top hinges.
     mesh: ReflectorMesh,
-    /// The cables' self weight, when the scene asks for gravity.
-    self_weight: Option<CableSelfWeight>,
+    /// The effects that load the nets (the cables' self weight).
+    effects: SceneEffects,
 }
 
 /// A two-stage design on one boundary.
@@ -208,19 +208,19 @@ impl TiedNets {
             n_front_cables,
             ties,
             mesh: mesh.clone(),
-            self_weight: None,
+            effects: SceneEffects::none(),
         })
     }
 
-    /// The same nets under the cables' self weight (`None`: weightless, as
-    /// in orbit): each design lumps the weight of every cable at the
-    /// geometry it designs for — the front net's, the ties to the rear
-    /// heights it starts from — half to each end node, in both stages and in
-    /// the whole network's forward solve. Along the axis the ties absorb the
-    /// vertical weight and the front net's plan problem is unchanged; across
-    /// it the weight enters plan equilibrium (front and rear).
-    pub fn with_cable_self_weight(mut self, self_weight: Option<CableSelfWeight>) -> Self {
-        self.self_weight = self_weight;
+    /// The same nets under the nodal loads of `effects` (none: weightless,
+    /// as in orbit). Each design evaluates the loads at the geometry it
+    /// designs for — for the cables' self weight: the front net's, the ties
+    /// to the rear heights it starts from, half to each end node — in both
+    /// stages and in the whole network's forward solve. Along the axis the
+    /// ties absorb vertical loads and the front net's plan problem is
+    /// unchanged; across it the loads enter plan equilibrium (front and rear).
+    pub fn with_effects(mut self, effects: &SceneEffects) -> Self {
+        self.effects = effects.clone();
         self
     }
 
@@ -261,17 +261,14 @@ impl TiedNets {
         // Without weight one pass; with it, the weight of the ties depends on
         // the rear heights stage 2 finds: repeat until the lumped weights are
         // those of the geometry designed (a few passes: they change little).
-        let mut weights = self
-            .self_weight
-            .map(|w| w.nodal_loads(&whole, &network.edges));
+        let mut weights = self.effects.net_loads_n(&whole, &network.edges);
         let mut passes = 0;
         let (front_design, q, alpha) = loop {
             passes += 1;
             let (front_design, q, alpha) = self.stages(solver, &mut whole, weights.as_deref())?;
-            let Some(w) = self.self_weight else {
+            let Some(new) = self.effects.net_loads_n(&whole, &network.edges) else {
                 break (front_design, q, alpha);
             };
-            let new = w.nodal_loads(&whole, &network.edges);
             let change = max_difference(&new, weights.as_deref().unwrap_or(&[]));
             let scale = max_difference(&new, &[]);
             if change <= WEIGHT_TOLERANCE * scale || passes >= MAX_WEIGHT_PASSES {

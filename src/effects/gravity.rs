@@ -12,7 +12,7 @@
 
 use nalgebra::Vector3;
 
-use super::{record, EffectKind};
+use super::{record, Effect, EffectKind};
 use crate::mechanics::{ModelBuilder, NodalLoad, NodeId, Rod};
 use crate::scene::Scene;
 
@@ -53,44 +53,73 @@ impl CableSelfWeight {
     }
 }
 
-/// The truss's self weight as dead loads: each element of `rods` half at each
-/// of its nodes, each of `hinges` its mass; empty when the scene does not ask
-/// for gravity.
-pub fn truss_self_weight(
-    scene: &Scene,
-    builder: &ModelBuilder,
-    rods: &[Rod],
-    hinges: &[NodeId],
-) -> Vec<NodalLoad> {
-    let Some(gravity) = &scene.effects.gravity else {
-        return Vec::new();
-    };
-    record(EffectKind::TrussSelfWeight);
-    let g = Vector3::from(gravity.vector_m_per_s2());
-    let t = &scene.truss;
-    let weight_per_m = t.density_kg_per_m3 * t.tube_area_m2() * g;
-    let position = |n: NodeId| builder.frame(n).map(|f| f.position_m);
-    let mut loads = Vec::new();
-    for rod in rods {
-        for pair in rod.nodes.windows(2) {
-            if let (Some(a), Some(b)) = (position(pair[0]), position(pair[1])) {
-                let half = 0.5 * (b - a).norm() * weight_per_m;
-                for &node in pair {
-                    loads.push(NodalLoad {
-                        node,
-                        force_n: half,
-                        moment_nm: Vector3::zeros(),
-                    });
+/// Gravity: the cables' weight on the nets, the rods' and hinges' weight on
+/// the truss.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gravity {
+    /// The cables' self weight.
+    pub cables: CableSelfWeight,
+    /// Weight per unit length of a truss tube, N/m.
+    pub tube_weight_n_per_m: Vector3<f64>,
+    /// Weight of one hinge body, N (none without a hinge mass).
+    pub hinge_weight_n: Option<Vector3<f64>>,
+}
+
+impl Gravity {
+    /// Gravity, when the scene asks for it.
+    pub fn of(scene: &Scene) -> Option<Self> {
+        let cables = CableSelfWeight::of(scene)?;
+        let g = Vector3::from(scene.effects.gravity.as_ref()?.vector_m_per_s2());
+        let t = &scene.truss;
+        Some(Gravity {
+            cables,
+            tube_weight_n_per_m: t.density_kg_per_m3 * t.tube_area_m2() * g,
+            hinge_weight_n: (t.hinge_mass_kg > 0.0).then(|| t.hinge_mass_kg * g),
+        })
+    }
+}
+
+impl Effect for Gravity {
+    fn name(&self) -> &str {
+        "gravity"
+    }
+
+    fn net_loads_n(&self, nodes_m: &[[f64; 3]], edges: &[[usize; 2]]) -> Option<Vec<[f64; 3]>> {
+        Some(self.cables.nodal_loads(nodes_m, edges))
+    }
+
+    /// Each element of `rods` half at each of its nodes, each of `hinges`
+    /// its weight.
+    fn truss_dead_loads(
+        &self,
+        frame: &ModelBuilder,
+        rods: &[Rod],
+        hinges: &[NodeId],
+    ) -> Vec<NodalLoad> {
+        record(EffectKind::TrussSelfWeight);
+        let position = |n: NodeId| frame.frame(n).map(|f| f.position_m);
+        let mut loads = Vec::new();
+        for rod in rods {
+            for pair in rod.nodes.windows(2) {
+                if let (Some(a), Some(b)) = (position(pair[0]), position(pair[1])) {
+                    let half = 0.5 * (b - a).norm() * self.tube_weight_n_per_m;
+                    for &node in pair {
+                        loads.push(NodalLoad {
+                            node,
+                            force_n: half,
+                            moment_nm: Vector3::zeros(),
+                        });
+                    }
                 }
             }
         }
+        if let Some(weight) = self.hinge_weight_n {
+            loads.extend(hinges.iter().map(|&node| NodalLoad {
+                node,
+                force_n: weight,
+                moment_nm: Vector3::zeros(),
+            }));
+        }
+        loads
     }
-    if t.hinge_mass_kg > 0.0 {
-        loads.extend(hinges.iter().map(|&node| NodalLoad {
-            node,
-            force_n: t.hinge_mass_kg * g,
-            moment_nm: Vector3::zeros(),
-        }));
-    }
-    loads
 }

@@ -485,7 +485,15 @@ fn measure(
     judge.truss.elements_per_rod = judge_elements;
     let network = outcome.problem.network();
     let design = &outcome.design;
-    let judged = verify(&judge, &nets.mesh, network, design, AssemblyTruss::Flexible).map(|v| {
+    let judged = verify(
+        &judge,
+        &nets.mesh,
+        &nets.effects,
+        network,
+        design,
+        AssemblyTruss::Flexible,
+    )
+    .map(|v| {
         let built_ratio = outcome
             .problem
             .sets()

@@ -17,12 +17,12 @@
 
 use nalgebra::Vector3;
 
-use super::rod_properties::{RodKind, TrussRod};
-use crate::effects::{self, EffectKind};
+use crate::effects::{self, EffectKind, SceneEffects};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::{
     JointKind, MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, RodSpec, Section,
 };
+use crate::scene::{RodKind, TrussRod};
 use crate::scene::{Scene, Supports};
 
 /// A ring-truss frame and where the net attaches to it.
@@ -34,9 +34,9 @@ pub struct RingTruss {
     pub attachments: Vec<NodeId>,
     /// The supported bottom hinges and their fixed components `[x, y, z]`.
     pub supports: Vec<(usize, [bool; 3])>,
-    /// Dead loads of the truss's own weight (empty without gravity), applied
-    /// with every set of attachment loads.
-    pub self_weight: Vec<NodalLoad>,
+    /// Dead loads of the scene's effects (the truss's own weight under
+    /// gravity; empty without), applied with every set of attachment loads.
+    pub dead_loads: Vec<NodalLoad>,
 }
 
 fn v(p: &[f64; 3]) -> Vector3<f64> {
@@ -53,35 +53,44 @@ pub struct RingTrussBuilder {
     pub attachments: Vec<NodeId>,
     /// The supported bottom hinges and their fixed components `[x, y, z]`.
     pub supports: Vec<(usize, [bool; 3])>,
-    /// Dead loads of the truss's own weight (empty without gravity).
-    pub self_weight: Vec<NodalLoad>,
+    /// Dead loads of the scene's effects (empty without gravity).
+    pub dead_loads: Vec<NodalLoad>,
 }
 
 impl RingTruss {
-    /// The frame of `scene`'s truss on the hinge layout `layout`.
+    /// The frame of `scene`'s truss on the hinge layout `layout`, with the
+    /// scene's `effects` (dead loads, rod sections).
     ///
     /// # Errors
     /// A degenerate layout (coincident hinges), named.
-    pub fn new(scene: &Scene, layout: &RingTrussLayout) -> Result<Self, MechanicsError> {
+    pub fn new(
+        scene: &Scene,
+        layout: &RingTrussLayout,
+        effects: &SceneEffects,
+    ) -> Result<Self, MechanicsError> {
         let RingTrussBuilder {
             builder,
             attachments,
             supports,
-            self_weight,
-        } = Self::builder(scene, layout);
+            dead_loads,
+        } = Self::builder(scene, layout, effects);
         Ok(RingTruss {
             model: builder.build()?,
             attachments,
             supports,
-            self_weight,
+            dead_loads,
         })
     }
 
     /// The frame of `scene`'s truss on `layout`, not yet built (validated by
     /// [`ModelBuilder::build`]): the one place a beam model of the truss is
-    /// constructed ([`crate::effects`] logs it), with its self weight when the
-    /// scene asks for gravity.
-    pub fn builder(scene: &Scene, layout: &RingTrussLayout) -> RingTrussBuilder {
+    /// constructed ([`crate::effects`] logs it), with the dead loads and rod
+    /// sections of `effects`.
+    pub fn builder(
+        scene: &Scene,
+        layout: &RingTrussLayout,
+        effects: &SceneEffects,
+    ) -> RingTrussBuilder {
         effects::record(EffectKind::BeamModel);
         let t = &scene.truss;
         let nominal = RodSpec {
@@ -94,17 +103,11 @@ impl RingTruss {
             elements: t.elements_per_rod,
             kind: t.element,
         };
-        // Measured rods (`[effects] rod_properties_csv`), else the nominal tube.
-        let spec = |kind: RodKind, bay: usize| match &scene.effects.rod_properties {
-            Some(table) => RodSpec {
-                section: table.section(TrussRod::new(kind, bay), &nominal.section),
-                ..nominal
-            },
-            None => nominal,
+        // The nominal tube, as the effects leave it (measured rods).
+        let spec = |kind: RodKind, bay: usize| RodSpec {
+            section: effects.rod_section(TrussRod::new(kind, bay), nominal.section),
+            ..nominal
         };
-        if scene.effects.rod_properties.is_some() {
-            effects::record(EffectKind::RodProperties);
-        }
         let n = layout.bays();
         let top: Vec<Vector3<f64>> = layout.top_m.iter().map(v).collect();
         let bottom: Vec<Vector3<f64>> = layout.bottom_m.iter().map(v).collect();
@@ -159,12 +162,12 @@ impl RingTruss {
             );
         }
         let attachments: Vec<NodeId> = top_hinges.into_iter().chain(bottom_hinges).collect();
-        let self_weight = effects::truss_self_weight(scene, &b, &rods, &attachments);
+        let dead_loads = effects.truss_dead_loads(&b, &rods, &attachments);
         RingTrussBuilder {
             builder: b,
             attachments,
             supports,
-            self_weight,
+            dead_loads,
         }
     }
 }

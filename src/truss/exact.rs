@@ -29,7 +29,7 @@ const COLD_FIRST_STEP: f64 = 0.5;
 pub struct ExactTruss {
     solver: StaticSolver,
     attachments: Vec<NodeId>,
-    self_weight: Vec<NodalLoad>,
+    dead_loads: Vec<NodalLoad>,
     points: Vec<[f64; 3]>,
     settings: StaticSettings,
     previous: Option<State>,
@@ -66,7 +66,7 @@ impl ExactTruss {
         Ok(ExactTruss {
             solver: StaticSolver::new(truss.model)?,
             attachments: truss.attachments,
-            self_weight: truss.self_weight,
+            dead_loads: truss.dead_loads,
             points: layout_points(layout),
             settings: StaticSettings {
                 initial_step: COLD_FIRST_STEP,
@@ -101,7 +101,7 @@ impl TrussOracle for ExactTruss {
         set_attachment_loads(
             &mut self.solver,
             &self.attachments,
-            &self.self_weight,
+            &self.dead_loads,
             loads_n,
         )?;
         let mut iterations = 0;

@@ -13,7 +13,7 @@ use crate::mechanics::{NodalLoad, StaticSolver};
 pub struct LinearTruss {
     solver: StaticSolver,
     attachments: Vec<usize>,
-    self_weight: Vec<NodalLoad>,
+    dead_loads: Vec<NodalLoad>,
     points: Vec<[f64; 3]>,
 }
 
@@ -26,7 +26,7 @@ impl LinearTruss {
         Ok(LinearTruss {
             solver: StaticSolver::new(truss.model)?,
             attachments: truss.attachments,
-            self_weight: truss.self_weight,
+            dead_loads: truss.dead_loads,
             points: layout_points(layout),
         })
     }
@@ -46,7 +46,7 @@ impl TrussOracle for LinearTruss {
         set_attachment_loads(
             &mut self.solver,
             &self.attachments,
-            &self.self_weight,
+            &self.dead_loads,
             loads_n,
         )?;
         let state = self.solver.linear_response()?;

@@ -28,7 +28,7 @@ pub fn limit_margin(truss: RingTruss, pull_n: &[[f64; 3]]) -> Result<LimitSearch
     check_loads(pull_n, truss.attachments.len())?;
     let mut model = truss.model;
     let mut loads = nodal_loads(&truss.attachments, pull_n);
-    loads.extend(truss.self_weight);
+    loads.extend(truss.dead_loads);
     model.set_loads(loads)?;
     let mut solver = StaticSolver::new(model)?;
     // Each solve of the search starts from a stable state close by: a step

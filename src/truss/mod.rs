@@ -14,19 +14,19 @@ mod exact;
 mod linear;
 mod margin;
 mod rigid;
-mod rod_properties;
 mod scene_response;
 
+pub use crate::scene::{RodKind, RodProperties, RodPropertiesError, RodStiffness, TrussRod};
 pub use builder::{RingTruss, RingTrussBuilder};
 pub use exact::ExactTruss;
 pub use linear::LinearTruss;
 pub use margin::{limit_margin, PRECISION as MARGIN_PRECISION, SEARCH_TO as MARGIN_SEARCH_TO};
 pub use rigid::RigidTruss;
-pub use rod_properties::{RodKind, RodProperties, RodPropertiesError, RodStiffness, TrussRod};
 pub use scene_response::{read_loads, respond, AttachmentResponse, LoadsFile, SceneTrussResponse};
 
 use serde::Serialize;
 
+use crate::effects::SceneEffects;
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::{MechanicsError, StaticTermination};
 use crate::scene::{Scene, TrussModel};
@@ -134,6 +134,11 @@ pub trait TrussOracle: Send {
     /// Deformed attachment points under `loads_n` (N, one per attachment point,
     /// the pull of the net on the hinge).
     fn respond(&mut self, loads_n: &[[f64; 3]]) -> Result<TrussResponse, TrussError>;
+    /// Whether the model deforms: a design for it is verified on the
+    /// flexible truss, with its limit margin (the rigid model: no).
+    fn deforms(&self) -> bool {
+        true
+    }
 }
 
 /// The reference attachment points of a layout: top hinges, then bottom hinges.
@@ -164,23 +169,25 @@ pub(crate) fn check_loads(loads_n: &[[f64; 3]], expected: usize) -> Result<(), T
 }
 
 /// Check `loads_n` against the attachment points and set them, with the
-/// truss's `self_weight`, as the dead loads of `solver`'s frame (forces at
+/// truss's `dead_loads`, as the dead loads of `solver`'s frame (forces at
 /// the hinge bodies `attachments`).
 pub(crate) fn set_attachment_loads(
     solver: &mut crate::mechanics::StaticSolver,
     attachments: &[crate::mechanics::NodeId],
-    self_weight: &[crate::mechanics::NodalLoad],
+    dead_loads: &[crate::mechanics::NodalLoad],
     loads_n: &[[f64; 3]],
 ) -> Result<(), TrussError> {
     check_loads(loads_n, attachments.len())?;
     let mut loads = exact::nodal_loads(attachments, loads_n);
-    loads.extend_from_slice(self_weight);
+    loads.extend_from_slice(dead_loads);
     solver.model_mut().set_loads(loads)?;
     Ok(())
 }
 
-/// The oracle a scene asks for (`[effects] truss`): only that model is built —
-/// a rigid scene never constructs a beam model.
+/// The oracle a scene asks for (`[effects] truss`), with the scene's
+/// `effects`: only that model is built — a rigid scene never constructs a
+/// beam model. This is the registry of truss models: a new model is its own
+/// file here, a variant of [`TrussModel`] and one arm below.
 ///
 /// # Errors
 /// A frame that cannot be built.
@@ -188,10 +195,12 @@ pub fn oracle(
     model: TrussModel,
     scene: &Scene,
     layout: &RingTrussLayout,
+    effects: &SceneEffects,
 ) -> Result<Box<dyn TrussOracle>, TrussError> {
+    let ring = || RingTruss::new(scene, layout, effects);
     Ok(match model {
         TrussModel::Rigid => Box::new(RigidTruss::new(layout)),
-        TrussModel::Linear => Box::new(LinearTruss::new(RingTruss::new(scene, layout)?, layout)?),
-        TrussModel::Exact => Box::new(ExactTruss::new(RingTruss::new(scene, layout)?, layout)?),
+        TrussModel::Linear => Box::new(LinearTruss::new(ring()?, layout)?),
+        TrussModel::Exact => Box::new(ExactTruss::new(ring()?, layout)?),
     })
 }

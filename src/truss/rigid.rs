@@ -36,4 +36,8 @@ impl TrussOracle for RigidTruss {
             time_s: 0.0,
         })
     }
+
+    fn deforms(&self) -> bool {
+        false
+    }
 }

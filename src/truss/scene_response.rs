@@ -7,6 +7,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::{oracle, TrussError};
+use crate::effects::SceneEffects;
 use crate::fdm::solve_network;
 use crate::geometry::build_mesh;
 use crate::scene::{Scene, TrussModel};
@@ -92,7 +93,7 @@ pub fn respond(
             ("net".to_string(), pull)
         }
     };
-    let mut truss = oracle(model, scene, &mesh.truss)?;
+    let mut truss = oracle(model, scene, &mesh.truss, &SceneEffects::of(scene))?;
     let response = truss.respond(&loads_n)?;
     let n = mesh.truss.bays();
     let attachments: Vec<AttachmentResponse> = truss

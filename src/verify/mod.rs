@@ -14,9 +14,9 @@
 //! documents the model and its stiffening factor. [`Verification::cable_model`]
 //! says which model an assembly used.
 
-mod cable_model;
+mod stiffening;
 
-pub use cable_model::{CableModel, INEXTENSIBLE_STIFFENING};
+pub use crate::effects::{CableModel, INEXTENSIBLE_STIFFENING};
 
 use std::time::Instant;
 
@@ -24,6 +24,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::algebra::norm3;
+use crate::effects::SceneEffects;
 use crate::geometry::ReflectorMesh;
 use crate::mechanics::{constraint_scale, State};
 use crate::mechanics::{
@@ -140,6 +141,7 @@ fn array(v: &Vector3<f64>) -> [f64; 3] {
 pub fn verify(
     scene: &Scene,
     mesh: &ReflectorMesh,
+    effects: &SceneEffects,
     network: &Network,
     design: &Design,
     truss: AssemblyTruss,
@@ -170,7 +172,7 @@ pub fn verify(
         )));
     }
 
-    let (mut b, attachments, self_weight) = match truss {
+    let (mut b, attachments, dead_loads) = match truss {
         AssemblyTruss::Rigid => {
             let mut b = ModelBuilder::new();
             let points = hinges
@@ -187,10 +189,10 @@ pub fn verify(
             let RingTrussBuilder {
                 builder,
                 attachments,
-                self_weight,
+                dead_loads,
                 ..
-            } = RingTruss::builder(scene, layout);
-            (builder, attachments, self_weight)
+            } = RingTruss::builder(scene, layout, effects);
+            (builder, attachments, dead_loads)
         }
     };
     // Net node → model node: attachments for the fixed ones, new points for the
@@ -210,7 +212,7 @@ pub fn verify(
         .collect();
     // The effects' dead loads: the truss's self weight, and the net's nodal
     // loads of the design (the cables' self weight, lumped as designed).
-    for l in self_weight {
+    for l in dead_loads {
         b.add_load(l.node, l.force_n, l.moment_nm);
     }
     for (i, p) in network.loads.iter().flatten().enumerate() {
@@ -243,7 +245,7 @@ pub fn verify(
     // motion being many times the cables' elastic stretch); then, if that
     // fails, from the undeformed truss with the prestrain ramped in load steps.
     let mut found = None;
-    if let Some((guess, guess_scale)) = truss_guess(scene, mesh, design, truss)? {
+    if let Some((guess, guess_scale)) = truss_guess(scene, mesh, effects, design, truss)? {
         let solver = StaticSolver::new(b.build()?)?;
         let mut start = solver.reference_state();
         start.frames[..guess.frames.len()].copy_from_slice(&guess.frames);
@@ -275,7 +277,7 @@ pub fn verify(
         });
     }
     // Inextensible cables: the elastic equilibrium stiffened in stages.
-    let cable_model = CableModel::of(scene);
+    let cable_model = effects.cable_model();
     let (solver, solution, newton_iterations, load_steps) = match cable_model {
         CableModel::Elastic => {
             let (n, s) = (solution.newton_iterations, solution.steps.len());
@@ -288,7 +290,7 @@ pub fn verify(
                 .enumerate()
                 .map(|(k, _)| [design.lengths_m[k], design.tensions_n[k]])
                 .collect();
-            cable_model::stiffen(&bare, &targets, ea, solver, solution, &settings)?
+            stiffening::stiffen(&bare, &targets, ea, solver, solution, &settings)?
         }
     };
     let ea = cable_model.axial_stiffness_n(&scene.cables);
@@ -365,6 +367,7 @@ pub fn verify(
 fn truss_guess(
     scene: &Scene,
     mesh: &ReflectorMesh,
+    effects: &SceneEffects,
     design: &Design,
     truss: AssemblyTruss,
 ) -> Result<Option<(State, f64)>, VerifyError> {
@@ -372,7 +375,7 @@ fn truss_guess(
         return Ok(None);
     }
     let layout = &mesh.truss;
-    let ring = RingTruss::new(scene, layout)?;
+    let ring = RingTruss::new(scene, layout, effects)?;
     let scale = constraint_scale(&ring.model);
     let mut exact =
         ExactTruss::new(ring, layout).map_err(|e| VerifyError::Mismatch(e.to_string()))?;

@@ -18,10 +18,17 @@
 //! a bound `max_force_density_n_per_m` the design does not meet is reported
 //! by the solver. Outside them a scene may still be valid; what is not is
 //! refused with the key named.
+//!
+//! The measured-rods table a scene may name (`[effects] rod_properties_csv`)
+//! is an input of the scene too: its format lives in `rod_properties.rs`.
+
+mod rod_properties;
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+
+pub use rod_properties::{RodKind, RodProperties, RodPropertiesError, RodStiffness, TrussRod};
 
 /// A whole reflector scene: the input of one run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -232,13 +239,13 @@ pub struct Effects {
     /// Measured rod properties: a CSV table of EA/EI (GJ, GA) per rod that
     /// overrides the nominal tube section of the rods it names, relative to
     /// the scene file's folder (format and rod names:
-    /// [`crate::truss::RodProperties`]). Absent: every rod is the nominal tube.
+    /// [`RodProperties`]). Absent: every rod is the nominal tube.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rod_properties_csv: Option<std::path::PathBuf>,
     /// The table of `rod_properties_csv`, read and validated by
     /// [`Scene::read`] / [`Scene::from_toml_in`] (only when the key is given).
     #[serde(skip)]
-    pub rod_properties: Option<crate::truss::RodProperties>,
+    pub rod_properties: Option<RodProperties>,
     /// Whether verification assembles elastic cables (`true`, the default:
     /// EA of `[cables]`, cut to `L₀ = ℓ/(1 + T/EA)`) or inextensible ones
     /// (`false`; see [`crate::verify::CableModel`]).
@@ -302,7 +309,7 @@ pub enum SceneError {
     /// The table of `effects.rod_properties_csv` cannot be read or is
     /// invalid; the message names the file, the line and the rod or column.
     #[error("`effects.rod_properties_csv`: {0}")]
-    RodProperties(#[from] crate::truss::RodPropertiesError),
+    RodProperties(#[from] RodPropertiesError),
     /// A value is out of its valid range.
     #[error("`{key}`: {reason}")]
     Invalid {
@@ -382,7 +389,7 @@ impl Scene {
     /// Reads the tables the effects name (only those asked for).
     fn read_effect_files(&mut self, folder: &Path) -> Result<(), SceneError> {
         if let Some(file) = &self.effects.rod_properties_csv {
-            let table = crate::truss::RodProperties::read(&folder.join(file), self.truss.bays)?;
+            let table = RodProperties::read(&folder.join(file), self.truss.bays)?;
             self.effects.rod_properties = Some(table);
         }
         Ok(())

@@ -6,7 +6,7 @@
 //!
 //! The table is read by [`crate::Scene::read`] only when the key is present,
 //! validated once against the scene's bays, and applied by
-//! [`super::RingTruss::builder`], so the linear and exact oracles, the limit
+//! [`crate::truss::RingTruss::builder`] (through the effect of [`crate::effects`]), so the linear and exact oracles, the limit
 //! margin and the verification assembly all see the same rods.
 //!
 //! # Rod names
