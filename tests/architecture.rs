@@ -6,6 +6,8 @@
 //! between a `mod.rs` and the files below it (declarations, re-exports) are
 //! left out.
 
+mod common;
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -23,7 +25,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// The module path of a file: `src/a/b.rs` → `a::b`, `src/a/mod.rs` → `a`.
 fn module_of(path: &Path) -> Vec<String> {
-    let rel = path.strip_prefix("src").unwrap();
+    let rel = path.strip_prefix(common::source_dir()).unwrap();
     let mut parts: Vec<String> = rel
         .iter()
         .map(|p| p.to_string_lossy().trim_end_matches(".rs").to_string())
@@ -142,7 +144,7 @@ struct Crate {
 impl Crate {
     fn read() -> Crate {
         let mut paths = Vec::new();
-        rust_files(Path::new("src"), &mut paths);
+        rust_files(&common::source_dir(), &mut paths);
         let mut files = BTreeMap::new();
         let mut exports = BTreeMap::new();
         let mut uses = BTreeMap::new();
@@ -246,8 +248,7 @@ fn cycles<T: Ord + Clone>(graph: &BTreeMap<T, BTreeSet<T>>) -> Vec<Vec<T>> {
         }
         seen
     };
-    let reachable: BTreeMap<T, BTreeSet<T>> =
-        graph.keys().map(|n| (n.clone(), reach(n))).collect();
+    let reachable: BTreeMap<T, BTreeSet<T>> = graph.keys().map(|n| (n.clone(), reach(n))).collect();
     let mut done = BTreeSet::new();
     let mut found = Vec::new();
     for n in graph.keys() {
@@ -292,7 +293,10 @@ fn no_two_top_level_modules_import_each_other() {
     // The design pipeline uses the lower layers, never the reverse.
     assert!(modules["design"].contains("truss") && modules["design"].contains("uniformity"));
     let found = cycles(&modules);
-    assert!(found.is_empty(), "import cycles between modules: {found:#?}");
+    assert!(
+        found.is_empty(),
+        "import cycles between modules: {found:#?}"
+    );
 }
 
 /// The reader: the dependency analysis sees through a `mod.rs` re-export.
@@ -302,6 +306,6 @@ fn a_re_exported_item_resolves_to_its_defining_file() {
     let path: Vec<String> = ["design", "TiedNets"].map(String::from).to_vec();
     assert_eq!(
         krate.resolve(&path, 0),
-        Some(PathBuf::from("src/design/tied_nets.rs"))
+        Some(common::source_dir().join("design/tied_nets.rs"))
     );
 }

@@ -3,10 +3,9 @@
 //! where the design is one of the truss, and on the flexible truss the
 //! conventional design's net losing more of its prestress.
 
-use std::path::Path;
+mod common;
 
-use ringmesh::design::scene_problem;
-use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
+use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind};
 use ringmesh::effects::SceneEffects;
 use ringmesh::geometry::ReflectorMesh;
 use ringmesh::scene::{Scene, TrussModel};
@@ -14,14 +13,6 @@ use ringmesh::truss::{layout_points, oracle};
 use ringmesh::uniformity::{Design, SolverKind};
 use ringmesh::verify::{verify, AssemblyTruss, CableModel, Verification, INEXTENSIBLE_STIFFENING};
 use ringmesh::Network;
-
-fn small_hex() -> (Scene, ReflectorMesh, TiedNets) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml");
-    let scene = Scene::read(&path).unwrap();
-    let (mesh, problem) = scene_problem(&scene).unwrap();
-    let nets = TiedNets::new(&mesh, problem).unwrap();
-    (scene, mesh, nets)
-}
 
 fn inextensible(scene: &Scene) -> Scene {
     let mut s = scene.clone();
@@ -66,10 +57,7 @@ fn kept(v: &Verification, design: &Design) -> f64 {
 /// The key: elastic unless the scene says otherwise.
 #[test]
 fn cables_are_elastic_unless_the_scene_says_otherwise() {
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml"),
-    )
-    .unwrap();
+    let text = std::fs::read_to_string(common::problem("small-hex.toml")).unwrap();
     let elastic = Scene::from_toml(&text, "x").unwrap();
     assert!(elastic.effects.cable_elasticity);
     assert_eq!(CableModel::of(&elastic), CableModel::Elastic);
@@ -91,7 +79,7 @@ fn cables_are_elastic_unless_the_scene_says_otherwise() {
 /// tensions to `EA*·ε·|x|/ℓ`, κ times the elastic floor.
 #[test]
 fn inextensible_rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let d = nets
         .design(solver.as_ref(), &layout_points(&mesh.truss))
@@ -122,7 +110,7 @@ fn inextensible_rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
 /// inextensible cables it lands on the paraboloid as with elastic ones.
 #[test]
 fn the_design_for_the_deforming_truss_survives_inextensible_assembly() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let mut truss = oracle(
         TrussModel::Exact,
@@ -175,7 +163,7 @@ fn the_design_for_the_deforming_truss_survives_inextensible_assembly() {
 /// near linear at this load.
 #[test]
 fn inextensible_cables_leave_the_conventional_design_slacker_and_the_hinges_closer() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let d = nets
         .design(solver.as_ref(), &layout_points(&mesh.truss))

@@ -1,25 +1,11 @@
 //! The command line: outputs of `mesh` and `fdm`, and clean failure (message,
 //! exit code 2, no output file) on bad input.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use serde_json::Value;
-
-fn ringmesh(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(args)
-        .output()
-        .expect("run ringmesh")
-}
-
-fn problem(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("problems")
-        .join(name)
-        .display()
-        .to_string()
-}
 
 fn path(dir: &tempfile::TempDir, name: &str) -> PathBuf {
     dir.path().join(name)
@@ -29,9 +15,9 @@ fn path(dir: &tempfile::TempDir, name: &str) -> PathBuf {
 fn mesh_writes_network_and_vtu_and_fdm_solves_it() {
     let dir = tempfile::tempdir().unwrap();
     let out = path(&dir, "hex");
-    let run = ringmesh(&[
+    let run = common::ringmesh(&[
         "mesh",
-        &problem("small-hex.toml"),
+        &common::problem_arg("small-hex.toml"),
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -55,7 +41,7 @@ fn mesh_writes_network_and_vtu_and_fdm_solves_it() {
     assert_eq!(json["groups"].as_array().unwrap().len(), 211);
 
     let result = path(&dir, "eq.json");
-    let run = ringmesh(&[
+    let run = common::ringmesh(&[
         "fdm",
         network.to_str().unwrap(),
         "-o",
@@ -85,7 +71,7 @@ fn mesh_writes_network_and_vtu_and_fdm_solves_it() {
 }
 
 fn assert_rejected(args: &[&str], output: &Path, needle: &str) {
-    let run = ringmesh(args);
+    let run = common::ringmesh(args);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
     assert!(
@@ -99,7 +85,7 @@ fn assert_rejected(args: &[&str], output: &Path, needle: &str) {
 fn bad_scene_fails_with_exit_2_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let scene = path(&dir, "bad.toml");
-    let text = std::fs::read_to_string(problem("small-hex.toml")).unwrap();
+    let text = std::fs::read_to_string(common::problem_arg("small-hex.toml")).unwrap();
     std::fs::write(
         &scene,
         text.replace(
@@ -144,7 +130,7 @@ fn bad_networks_fail_with_exit_2_and_write_nothing() {
     let out = path(&dir, "eq.json");
     let input = path(&dir, "good.json");
     std::fs::write(&input, good).unwrap();
-    let run = ringmesh(&["fdm", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let run = common::ringmesh(&["fdm", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(
         run.status.success(),
         "{}",
@@ -160,13 +146,6 @@ fn bad_networks_fail_with_exit_2_and_write_nothing() {
             needle,
         );
     }
-}
-
-fn reference() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/reference/hex5-lp.json")
-        .display()
-        .to_string()
 }
 
 /// The gradient solver on a network file, without and with a bound `[q]`: a
@@ -188,12 +167,12 @@ fn uniformity_gradient_on_a_network_file_respects_the_bound() {
             "-o",
             out.to_str().unwrap(),
         ];
-        let reference = reference();
+        let reference = common::reference_path().display().to_string();
         args[1] = &reference;
         if let Some(b) = bound {
             args.extend(["--max-force-density", b]);
         }
-        let run = ringmesh(&args);
+        let run = common::ringmesh(&args);
         assert!(
             run.status.success(),
             "{bound:?}: {}",
@@ -212,7 +191,7 @@ fn uniformity_gradient_on_a_network_file_respects_the_bound() {
     assert_rejected(
         &[
             "uniformity",
-            &reference(),
+            &common::reference_path().display().to_string(),
             "--max-force-density=-1",
             "-o",
             out.to_str().unwrap(),
@@ -227,9 +206,9 @@ fn uniformity_on_the_reference_network_reproduces_its_optimum() {
     let dir = tempfile::tempdir().unwrap();
     let out = path(&dir, "u.json");
     for solver in ["lp", "bisection"] {
-        let run = ringmesh(&[
+        let run = common::ringmesh(&[
             "uniformity",
-            &reference(),
+            &common::reference_path().display().to_string(),
             "--solver",
             solver,
             "--groups",
@@ -262,7 +241,7 @@ fn uniformity_on_the_reference_network_reproduces_its_optimum() {
     assert_rejected(
         &[
             "uniformity",
-            &reference(),
+            &common::reference_path().display().to_string(),
             "--groups",
             "front,cable",
             "-o",
@@ -277,9 +256,9 @@ fn uniformity_on_the_reference_network_reproduces_its_optimum() {
 fn optimize_writes_design_and_cut_lengths() {
     let dir = tempfile::tempdir().unwrap();
     let out = path(&dir, "opt");
-    let run = ringmesh(&[
+    let run = common::ringmesh(&[
         "optimize",
-        &problem("small-hex.toml"),
+        &common::problem_arg("small-hex.toml"),
         "--solver",
         "lp",
         "-o",
@@ -323,9 +302,9 @@ fn optimize_writes_design_and_cut_lengths() {
 fn front_writes_csv_and_plots() {
     let dir = tempfile::tempdir().unwrap();
     let out = path(&dir, "front");
-    let run = ringmesh(&[
+    let run = common::ringmesh(&[
         "front",
-        &problem("small-hex.toml"),
+        &common::problem_arg("small-hex.toml"),
         "--solvers",
         "bisection",
         "--points",

@@ -1,12 +1,11 @@
 //! The outer design loop and verification by assembly (paper §4–5, DESIGN §6–7)
 //! on the small test scene.
 
-use std::path::Path;
+mod common;
 
 use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
 use ringmesh::design::{scene_problem, DesignSettings};
 use ringmesh::effects::SceneEffects;
-use ringmesh::geometry::ReflectorMesh;
 use ringmesh::run::design;
 use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{
@@ -14,13 +13,6 @@ use ringmesh::truss::{
 };
 use ringmesh::uniformity::SolverKind;
 use ringmesh::verify::{verify, AssemblyTruss};
-
-fn small_hex() -> (Scene, ReflectorMesh, TiedNets) {
-    let scene = Scene::read(Path::new("problems/small-hex.toml")).unwrap();
-    let (mesh, problem) = scene_problem(&scene).unwrap();
-    let nets = TiedNets::new(&mesh, problem).unwrap();
-    (scene, mesh, nets)
-}
 
 fn settings(relaxation: RelaxationKind) -> LoopSettings {
     LoopSettings {
@@ -36,7 +28,7 @@ fn settings(relaxation: RelaxationKind) -> LoopSettings {
 /// for a rigid truss does not.
 #[test]
 fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let mut truss = oracle(
         TrussModel::Exact,
@@ -169,7 +161,7 @@ fn a_design_past_the_truss_limit_load_is_refused() {
 /// truss — the assembly returns the design itself.
 #[test]
 fn rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let design = nets
         .design(solver.as_ref(), &layout_points(&mesh.truss))
@@ -194,7 +186,7 @@ fn rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
 /// hinges) needs no prescribed rear geometry.
 #[test]
 fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let mut truss = oracle(
         TrussModel::Exact,
         &scene,
@@ -228,7 +220,7 @@ fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
 /// The outer loop on the rigid truss is one design: the boundary never moves.
 #[test]
 fn rigid_truss_loop_stops_after_one_design() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let mut truss = oracle(
         TrussModel::Rigid,
@@ -260,7 +252,7 @@ fn rigid_truss_loop_stops_after_one_design() {
 /// margin, and Anderson mixing needs the fewest outer iterations.
 #[test]
 fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
-    let (scene, mesh, nets) = small_hex();
+    let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let iterations = |relaxation| {
         let mut truss = oracle(

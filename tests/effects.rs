@@ -2,6 +2,8 @@
 //! gravity acts as physics says — absorbed by the vertical ties along the
 //! reflector's axis, entering plan equilibrium across it.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use ringmesh::design::TiedNets;
@@ -18,7 +20,7 @@ use ringmesh::uniformity::{Design, SolverKind};
 
 /// small-hex, optionally under gravity along `direction`, written to `dir`.
 fn small_hex(dir: &Path, gravity: Option<[f64; 3]>) -> PathBuf {
-    let mut text = std::fs::read_to_string("problems/small-hex.toml").unwrap();
+    let mut text = std::fs::read_to_string(common::problem("small-hex.toml")).unwrap();
     if let Some(d) = gravity {
         text.push_str(&format!(
             "\n[effects.gravity]\nacceleration_m_per_s2 = 9.81\ndirection = [{:?}, {:?}, {:?}]\n",

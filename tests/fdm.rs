@@ -1,30 +1,18 @@
 //! The force density method against closed forms, symmetry, global balance,
 //! finite differences and an independent implementation's data.
 
+mod common;
+
 use ringmesh::fdm::{solve_network, FdmStructure};
 use ringmesh::geometry::build_mesh;
 use ringmesh::{Network, Scene};
 
-fn scene(name: &str) -> Scene {
-    Scene::read(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("problems/{name}.toml")),
-    )
-    .unwrap()
-}
-
 /// A scene with the given bays and rings, on a 26 m aperture.
 fn sized_scene(bays: usize, rings: usize) -> Scene {
-    let mut s = scene("realistic-26m");
+    let mut s = common::scene("realistic-26m");
     s.truss.bays = bays;
     s.front_net.rings = rings;
     s
-}
-
-fn max_abs_diff(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    a.iter()
-        .zip(b)
-        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
-        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -122,7 +110,7 @@ fn symmetric_net_with_symmetric_q_has_rotational_symmetry() {
     // Initial q is uniform per group, so it shares the N-fold symmetry of the
     // sector grid; rotating node (ring i, sector k, j) by 2π/N must land on node
     // (i, k+1, j).
-    let mesh = build_mesh(&scene("small-hex")).unwrap();
+    let mesh = build_mesh(&common::scene("small-hex")).unwrap();
     let (bays, rings) = (6usize, 3usize);
     let (_, eq) = solve_network(&mesh.network).unwrap();
     let x = &eq.nodes_xyz_m;
@@ -136,18 +124,18 @@ fn symmetric_net_with_symmetric_q_has_rotational_symmetry() {
             for local in 0..bays * i {
                 let image = first + (local + i) % (bays * i);
                 let (a, b) = (rotate(x[net + first + local]), x[net + image]);
-                worst = worst.max(max_abs_diff(&[a], &[b]));
+                worst = worst.max(common::max_abs_diff(&[a], &[b]));
             }
         }
     }
     assert!(worst <= 1e-12, "asymmetry {worst:e} m");
     // And the shape is not trivially the input geometry: the hub moved.
-    assert!(max_abs_diff(&x[..1], &mesh.network.nodes[..1]) > 1e-6);
+    assert!(common::max_abs_diff(&x[..1], &mesh.network.nodes[..1]) > 1e-6);
 }
 
 #[test]
 fn reactions_balance_loads_in_force_and_moment() {
-    let mut network = build_mesh(&scene("small-offset")).unwrap().network;
+    let mut network = build_mesh(&common::scene("small-offset")).unwrap().network;
     let loads: Vec<[f64; 3]> = (0..network.n_nodes())
         .map(|i| {
             let t = i as f64;
@@ -192,7 +180,7 @@ fn reactions_balance_loads_in_force_and_moment() {
 
 #[test]
 fn d_matrix_equals_cft_q_cf() {
-    let network = build_mesh(&scene("small-hex")).unwrap().network;
+    let network = build_mesh(&common::scene("small-hex")).unwrap().network;
     let structure = FdmStructure::new(&network).unwrap();
     let q: Vec<f64> = (0..network.n_edges())
         .map(|k| 1.0 + (k % 7) as f64)
@@ -213,7 +201,7 @@ fn d_matrix_equals_cft_q_cf() {
 
 #[test]
 fn equilibrium_matrix_times_q_is_the_load_at_equilibrium() {
-    let mut network = build_mesh(&scene("small-offset")).unwrap().network;
+    let mut network = build_mesh(&common::scene("small-offset")).unwrap().network;
     let loads: Vec<[f64; 3]> = (0..network.n_nodes())
         .map(|i| [0.0, 0.1 * (i % 3) as f64, -1.0])
         .collect();
@@ -238,7 +226,7 @@ fn equilibrium_matrix_times_q_is_the_load_at_equilibrium() {
 
 #[test]
 fn adjoint_sensitivities_match_central_differences() {
-    let network = build_mesh(&scene("small-offset")).unwrap().network;
+    let network = build_mesh(&common::scene("small-offset")).unwrap().network;
     let structure = FdmStructure::new(&network).unwrap();
     let target: Vec<f64> = network.nodes.iter().map(|p| p[2]).collect();
     let weights: Vec<f64> = (0..network.n_edges())
@@ -283,18 +271,11 @@ fn adjoint_sensitivities_match_central_differences() {
     assert!(worst <= 1e-6, "worst relative error {worst:e}");
 }
 
-/// The reference data of an independent implementation (shared/reference).
-fn reference_network() -> Network {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference/hex5-lp.json");
-    Network::read_json(&path).expect("shared/reference/hex5-lp.json beside the checkout")
-}
-
 #[test]
 fn reference_q_reproduces_reference_geometry() {
-    let network = reference_network();
+    let network = common::reference_network();
     let (_, eq) = solve_network(&network).unwrap();
-    let error = max_abs_diff(&eq.nodes_xyz_m, &network.nodes);
+    let error = common::max_abs_diff(&eq.nodes_xyz_m, &network.nodes);
     assert!(
         error <= 1e-11,
         "forward FDM moved the reference nodes by {error:e} m"
@@ -303,16 +284,16 @@ fn reference_q_reproduces_reference_geometry() {
 
 #[test]
 fn generator_reproduces_reference_front_net() {
-    let reference = reference_network();
+    let reference = common::reference_network();
     // The reference: hexagon, 5 rings, D = 26 m, F = 4 m, sag 5 % of the bay chord.
-    let mut s = scene("small-hex");
+    let mut s = common::scene("small-hex");
     s.reflector.aperture_diameter_m = 26.0;
     s.front_net.rings = 5;
     s.front_net.boundary_sag_ratio = 0.05;
     s.truss.height_m = 20.0;
     let mesh = build_mesh(&s).unwrap();
     assert_eq!(mesh.n_front_nodes, 91);
-    let error = max_abs_diff(&mesh.network.nodes[..91], &reference.nodes[..91]);
+    let error = common::max_abs_diff(&mesh.network.nodes[..91], &reference.nodes[..91]);
     assert!(
         error <= 1e-12,
         "front net differs from the reference by {error:e} m"

@@ -3,31 +3,16 @@
 //! with the key at fault named, and the `frame` and `cantilever` commands
 //! write what they document.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
 use nalgebra::Vector3;
 use ringmesh::mechanics::cantilever;
 use ringmesh::mechanics::{FrameFile, FrameFileError, StaticSolver, StaticTermination};
 use serde_json::Value;
 
-fn problem(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("problems/frames")
-        .join(name)
-}
-
-fn ringmesh(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run ringmesh")
-}
-
 #[test]
 fn cantilever_file_rolls_up_into_the_full_circle() {
-    let file = FrameFile::read(&problem("cantilever-moment.toml")).unwrap();
+    let file = FrameFile::read(&common::problem("frames/cantilever-moment.toml")).unwrap();
     let tip = file.rod("cantilever").unwrap().end();
     let solver = StaticSolver::new(file.model.clone()).unwrap();
     let solution = solver.solve(&file.settings).unwrap();
@@ -49,7 +34,7 @@ fn cantilever_file_rolls_up_into_the_full_circle() {
 
 #[test]
 fn ring_truss_under_self_equilibrated_loads_on_an_isostatic_support_has_no_reactions() {
-    let file = FrameFile::read(&problem("ring-truss-frame.toml")).unwrap();
+    let file = FrameFile::read(&common::problem("frames/ring-truss-frame.toml")).unwrap();
     assert_eq!(file.bodies.len(), 12);
     assert_eq!(file.model.rods().len(), 24);
     let solver = StaticSolver::new(file.model.clone()).unwrap();
@@ -278,10 +263,12 @@ fn malformed_frame_files_name_the_key_at_fault() {
 fn frame_command_writes_positions_rotations_reactions_and_solver_stats() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("cantilever.json");
-    let run = ringmesh(
+    let run = common::ringmesh_in(
         &[
             "frame",
-            problem("cantilever-moment.toml").to_str().unwrap(),
+            common::problem("frames/cantilever-moment.toml")
+                .to_str()
+                .unwrap(),
             "-o",
             out.to_str().unwrap(),
         ],
@@ -334,8 +321,13 @@ fn frame_command_writes_positions_rotations_reactions_and_solver_stats() {
 #[test]
 fn frame_command_writes_to_results_by_default() {
     let dir = tempfile::tempdir().unwrap();
-    let run = ringmesh(
-        &["frame", problem("ring-truss-frame.toml").to_str().unwrap()],
+    let run = common::ringmesh_in(
+        &[
+            "frame",
+            common::problem("frames/ring-truss-frame.toml")
+                .to_str()
+                .unwrap(),
+        ],
         dir.path(),
     );
     assert!(
@@ -356,7 +348,7 @@ fn frame_command_rejects_a_bad_file_with_exit_code_2_and_writes_nothing() {
     let bad = dir.path().join("bad.toml");
     std::fs::write(&bad, with("elements = 2", "elements = 0")).unwrap();
     let out = dir.path().join("out.json");
-    let run = ringmesh(
+    let run = common::ringmesh_in(
         &["frame", bad.to_str().unwrap(), "-o", out.to_str().unwrap()],
         dir.path(),
     );
@@ -374,7 +366,7 @@ fn frame_command_rejects_a_bad_file_with_exit_code_2_and_writes_nothing() {
 #[test]
 fn cantilever_command_json_has_every_load_converged() {
     let dir = tempfile::tempdir().unwrap();
-    let run = ringmesh(&["cantilever", "--json"], dir.path());
+    let run = common::ringmesh_in(&["cantilever", "--json"], dir.path());
     assert!(
         run.status.success(),
         "{}",
@@ -409,7 +401,7 @@ fn cantilever_command_json_has_every_load_converged() {
 #[test]
 fn cantilever_command_prints_the_table_with_the_paper_column() {
     let dir = tempfile::tempdir().unwrap();
-    let run = ringmesh(
+    let run = common::ringmesh_in(
         &[
             "cantilever",
             "--elements",
@@ -431,6 +423,6 @@ fn cantilever_command_prints_the_table_with_the_paper_column() {
     );
     assert_eq!(stdout.lines().count(), 3 + 7, "{stdout}");
     assert!(!stdout.contains("NOT CONVERGED"), "{stdout}");
-    let zero = ringmesh(&["cantilever", "--elements", "0"], dir.path());
+    let zero = common::ringmesh_in(&["cantilever", "--elements", "0"], dir.path());
     assert_eq!(zero.status.code(), Some(2));
 }

@@ -6,24 +6,16 @@
 //! through the pipeline (mesh and forward solve, frame analysis and solve)
 //! without a panic.
 
+mod common;
+
 use std::path::Path;
 
 use proptest::prelude::*;
-use proptest::test_runner::RngSeed;
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::{FrameFile, StaticSolver};
 use ringmesh::scene::Scene;
 use toml::{Table, Value};
-
-fn config(cases: u32, seed: u64) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: RngSeed::Fixed(seed),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
 
 fn read(relative: &str) -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)).unwrap()
@@ -176,7 +168,7 @@ fn apply(text: &str, m: &Mutation) -> (String, String) {
 }
 
 proptest! {
-    #![proptest_config(config(160, 0x5eed_1001))]
+    #![proptest_config(common::proptest_config(160, 0x5eed_1001))]
 
     /// A mutated scene is accepted and builds (and its net solves) without a
     /// panic, or is refused naming the mutated key or the key at fault.

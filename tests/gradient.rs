@@ -2,28 +2,14 @@
 //! differences, descent to a stationary point, and designs within 5 % of the LP
 //! optimum with a sub-micrometre surface on the small test scenes.
 
-use std::path::Path;
+mod common;
 
+use ringmesh::algebra::norm2;
 use ringmesh::geometry::build_mesh;
 use ringmesh::uniformity::{
     Gradient, Lp, SurfaceTarget, Termination, UniformityProblem, UniformitySet, UniformitySolver,
 };
 use ringmesh::{CableGroup, Scene};
-
-fn scene(name: &str) -> Scene {
-    Scene::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("problems/{name}.toml")))
-        .unwrap()
-}
-
-fn front_problem(scene: &Scene) -> UniformityProblem {
-    let mesh = build_mesh(scene).unwrap();
-    UniformityProblem::from_mesh(
-        &mesh,
-        &[(CableGroup::Front, scene.front_net.mean_tension_n)],
-        scene.cables.max_force_density_n_per_m,
-    )
-    .unwrap()
-}
 
 /// The front net of a scene judged against its prescribed (design) positions.
 fn prescribed_problem(scene: &Scene) -> UniformityProblem {
@@ -45,10 +31,6 @@ fn prescribed_problem(scene: &Scene) -> UniformityProblem {
         scene.cables.max_force_density_n_per_m,
     )
     .unwrap()
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// `θ` of the network's `q`, moved off it by a deterministic pattern of
@@ -109,7 +91,7 @@ fn assert_gradient_matches_central_differences(solver: &Gradient, problem: &Unif
 
 #[test]
 fn gradient_matches_central_differences_on_the_paraboloid() {
-    let problem = front_problem(&scene("small-hex"));
+    let problem = common::front_problem(&common::scene("small-hex"));
     for weight in [1e-6, 1e-2] {
         let solver = Gradient {
             weight,
@@ -121,7 +103,7 @@ fn gradient_matches_central_differences_on_the_paraboloid() {
 
 #[test]
 fn gradient_matches_central_differences_offset_and_free_layout() {
-    let problem = front_problem(&scene("small-offset"));
+    let problem = common::front_problem(&common::scene("small-offset"));
     let solver = Gradient {
         weight: 1e-2,
         layout_weight: 0.0,
@@ -132,7 +114,7 @@ fn gradient_matches_central_differences_offset_and_free_layout() {
 
 #[test]
 fn gradient_matches_central_differences_with_prescribed_target() {
-    let problem = prescribed_problem(&scene("small-hex"));
+    let problem = prescribed_problem(&common::scene("small-hex"));
     let solver = Gradient {
         weight: 1e-2,
         ..Gradient::default()
@@ -142,7 +124,7 @@ fn gradient_matches_central_differences_with_prescribed_target() {
 
 #[test]
 fn gradient_descends_to_a_stationary_point() {
-    let problem = front_problem(&scene("small-hex"));
+    let problem = common::front_problem(&common::scene("small-hex"));
     let solver = Gradient::default();
     let (design, history) = solver.solve_with_history(&problem).unwrap();
     assert_eq!(
@@ -158,10 +140,10 @@ fn gradient_descends_to_a_stationary_point() {
     let (j_end, g_end) = solver.objective_and_gradient(&problem, &end).unwrap();
     assert!(j_end < 1e-3 * j_start, "J {j_start:e} -> {j_end:e}");
     assert!(
-        norm(&g_end) <= 1e-6 * norm(&g_start),
+        norm2(&g_end) <= 1e-6 * norm2(&g_start),
         "|dJ/dθ| {:e} -> {:e}",
-        norm(&g_start),
-        norm(&g_end)
+        norm2(&g_start),
+        norm2(&g_end)
     );
     // Every run decreases its objective (each run has its own sharpness, so
     // compare within runs: a rise can only come at a restart).
@@ -182,8 +164,8 @@ fn gradient_descends_to_a_stationary_point() {
 
 /// Within 5 % of the LP optimum, a surface RMS of at most 1 µm, and `q` in bounds.
 fn assert_near_lp_optimum(name: &str) {
-    let scene = scene(name);
-    let problem = front_problem(&scene);
+    let scene = common::scene(name);
+    let problem = common::front_problem(&scene);
     let lp = Lp.solve(&problem).unwrap();
     let design = Gradient::default().solve(&problem).unwrap();
     assert_eq!(
@@ -221,7 +203,7 @@ fn gradient_reaches_lp_optimum_on_offset_scene() {
 
 #[test]
 fn weight_trades_surface_error_for_uniformity() {
-    let problem = front_problem(&scene("small-hex"));
+    let problem = common::front_problem(&common::scene("small-hex"));
     let designs: Vec<_> = [1e-6, 1e-4, 1e-2]
         .iter()
         .map(|&weight| {
@@ -244,7 +226,7 @@ fn free_layout_slides_to_an_equal_tension_net() {
     // Without the layout term, only the vertical error counts: the front net
     // moves in plan to a layout with uniform tension, below the LP optimum of
     // the designed layout, which is then a different problem.
-    let problem = front_problem(&scene("small-hex"));
+    let problem = common::front_problem(&common::scene("small-hex"));
     let lp = Lp.solve(&problem).unwrap();
     let design = Gradient {
         layout_weight: 0.0,

@@ -34,14 +34,6 @@ use common::{angle_between, net_pull, newton_from, perturbed, scaled, scene, Ran
 
 const EPS: f64 = f64::EPSILON;
 
-/// Largest `‖p − q‖∞` over two point lists.
-fn max_abs_diff(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    a.iter()
-        .zip(b)
-        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
-        .fold(0.0, f64::max)
-}
-
 // ---------------------------------------------------------------------------
 // 1. Force densities spanning 1e-6 … 1e6 in one net
 
@@ -110,7 +102,7 @@ fn force_densities_over_twelve_decades_keep_equilibrium() {
     for (k, w) in chain.windows(2).enumerate() {
         partial += 1.0 / q[k];
         let expected = [length * partial / compliance, 0.0, 0.0];
-        worst = worst.max(max_abs_diff(&[eq.nodes_xyz_m[w[1]]], &[expected]));
+        worst = worst.max(common::max_abs_diff(&[eq.nodes_xyz_m[w[1]]], &[expected]));
     }
     // cond(D) ≈ 1e15 here: plain Cholesky leaves the nodes 1e-3 L off;
     // refinement against the edge-form residual brings them to ~4e-9 L.
@@ -265,7 +257,7 @@ fn flat_and_deep_dishes_of_one_and_a_hundred_metres_keep_relative_accuracy() {
             .iter()
             .map(|p| p.map(|v| 100.0 * v))
             .collect();
-        let shape = max_abs_diff(&scaled_small, &large.nodes_xyz_m) / 100.0;
+        let shape = common::max_abs_diff(&scaled_small, &large.nodes_xyz_m) / 100.0;
         assert!(
             shape <= 1e-12,
             "F/D {f_over_d}: shapes differ by {shape:e} × D"
@@ -613,7 +605,7 @@ fn slack_cables_in_verification_are_reported_and_carry_nothing() {
     )
     .unwrap();
     assert!(reference.slack_cables.is_empty());
-    let shift = max_abs_diff(&v.nodes_xyz_m, &reference.nodes_xyz_m);
+    let shift = common::max_abs_diff(&v.nodes_xyz_m, &reference.nodes_xyz_m);
     // A slack cable still pushes with its regularisation, 1e-9 EA × 5 %
     // ≈ 5e-5 N, against the net's transverse stiffness T/ℓ ≈ 100 N/m.
     assert!(

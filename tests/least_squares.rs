@@ -3,33 +3,24 @@
 //! and an optimum outside `0 < q ≤ [q]` is reported, naming the cables, never
 //! returned.
 
-use std::path::Path;
+mod common;
 
 use faer::Mat;
+use ringmesh::algebra::norm2;
 use ringmesh::uniformity::{
     LeastSquares, Lp, SurfaceTarget, Termination, UniformityError, UniformityProblem,
     UniformitySet, UniformitySolver,
 };
-use ringmesh::{CableGroup, Network, Scene};
+use ringmesh::Network;
 
 fn scene_problem(name: &str) -> UniformityProblem {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("problems/{name}.toml"));
-    let scene = Scene::read(path.as_path()).unwrap();
-    let mesh = ringmesh::geometry::build_mesh(&scene).unwrap();
-    UniformityProblem::from_mesh(
-        &mesh,
-        &[(CableGroup::Front, scene.front_net.mean_tension_n)],
-        scene.cables.max_force_density_n_per_m,
-    )
-    .unwrap()
+    common::front_problem(&common::scene(name))
 }
 
 /// The reference front net with uniformity sets `(groups joined by '+', target)`;
 /// cables of other groups (the ties) are in no set.
 fn hex5_problem(sets: &[(&str, f64)]) -> UniformityProblem {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference/hex5-lp.json");
-    let network =
-        Network::read_json(&path).expect("shared/reference/hex5-lp.json beside the checkout");
+    let network = common::reference_network();
     let sets = sets
         .iter()
         .map(|&(name, mean_tension_n)| UniformitySet {
@@ -97,10 +88,6 @@ fn matvec_t(a: &Mat<f64>, y: &[f64]) -> Vec<f64> {
     (0..a.ncols())
         .map(|j| (0..a.nrows()).map(|i| a[(i, j)] * y[i]).sum())
         .collect()
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// `A q − p`.
@@ -180,10 +167,10 @@ fn equality_optimum_satisfies_its_kkt_conditions() {
         let g = uniformity_gradient(&problem, &design.q);
         let rest = outside_row_space(&a, &g);
         assert!(
-            norm(&rest) <= 1e-8 * norm(&g),
+            norm2(&rest) <= 1e-8 * norm2(&g),
             "{name}: |g outside row space| = {:e}, |g| = {:e}",
-            norm(&rest),
-            norm(&g)
+            norm2(&rest),
+            norm2(&g)
         );
     }
 }
@@ -241,11 +228,11 @@ fn tikhonov_optimum_satisfies_its_normal_equations() {
                 .zip(&uniformity)
                 .map(|(e, u)| e + lambda * u)
                 .collect();
-            let scale = norm(&equilibrium) + lambda * norm(&uniformity);
+            let scale = norm2(&equilibrium) + lambda * norm2(&uniformity);
             assert!(
-                norm(&gradient) <= 1e-8 * scale,
+                norm2(&gradient) <= 1e-8 * scale,
                 "{name} λ {lambda}: |∇| = {:e}, scale {scale:e}",
-                norm(&gradient)
+                norm2(&gradient)
             );
         }
     }
@@ -267,7 +254,7 @@ fn larger_lambda_trades_equilibrium_for_uniformity() {
             }
             .solve(&problem)
             .unwrap();
-            let f = norm(&equilibrium_residual(&problem, &a, &design.q)).powi(2);
+            let f = norm2(&equilibrium_residual(&problem, &a, &design.q)).powi(2);
             let g = deviation_squared(&problem, &design.q);
             let slack = 1e-9;
             assert!(

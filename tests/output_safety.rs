@@ -2,6 +2,8 @@
 //! and renamed, so a run killed mid-way leaves the previous results intact
 //! and readable.
 
+mod common;
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -29,11 +31,7 @@ fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
 fn a_design_run_killed_in_its_outer_loop_leaves_the_previous_results_intact() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("realistic-26m.toml");
-    std::fs::copy(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/realistic-26m.toml"),
-        &scene,
-    )
-    .unwrap();
+    std::fs::copy(common::problem("realistic-26m.toml"), &scene).unwrap();
     let out: PathBuf = dir.path().join("results").join("realistic-26m");
     let args = [
         "design",
@@ -114,7 +112,7 @@ fn a_design_run_killed_in_its_outer_loop_leaves_the_previous_results_intact() {
 /// path): no other place in `src/` creates or writes a file.
 #[test]
 fn only_the_atomic_writers_touch_the_file_system() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let src = common::source_dir();
     let mut stack = vec![src.clone()];
     let mut offenders = Vec::new();
     while let Some(dir) = stack.pop() {

@@ -6,9 +6,10 @@
 //! Seeds are fixed, so a run is reproducible; the case counts keep the file
 //! to a few seconds.
 
+mod common;
+
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
-use proptest::test_runner::RngSeed;
 use ringmesh::design::scene_problem;
 use ringmesh::fdm::solve_network;
 use ringmesh::mechanics::rotation::{exp, log, skew};
@@ -17,15 +18,6 @@ use ringmesh::uniformity::{SolverKind, Termination};
 use ringmesh::Network;
 
 const EPS: f64 = f64::EPSILON;
-
-fn config(cases: u32, seed: u64) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: RngSeed::Fixed(seed),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
 
 // ---------------------------------------------------------------------------
 // Random nets
@@ -75,7 +67,7 @@ fn random_net() -> impl Strategy<Value = Network> {
 }
 
 proptest! {
-    #![proptest_config(config(64, 0x5eed_0001))]
+    #![proptest_config(common::proptest_config(64, 0x5eed_0001))]
 
     /// Every free node balances: `‖p − Σ q u‖ ≤ 1e-9 × (largest force or load)`.
     #[test]
@@ -117,7 +109,7 @@ fn unit_axis() -> impl Strategy<Value = Vector3<f64>> {
 }
 
 proptest! {
-    #![proptest_config(config(256, 0x5eed_0002))]
+    #![proptest_config(common::proptest_config(256, 0x5eed_0002))]
 
     /// `exp` then `log` gives back the same rotation, with the principal
     /// angle in [0, π]; for angles below π it gives back the vector itself.
@@ -187,9 +179,7 @@ fn random_scene() -> impl Strategy<Value = Scene> {
     )
         .prop_map(
             |((d, f_over_d, offset), (bays, rings, sag), (rear, margin), (front_t, rear_t))| {
-                let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join("problems/small-hex.toml");
-                let mut s = Scene::read(&path).unwrap();
+                let mut s = common::scene("small-hex");
                 let f = f_over_d * d;
                 s.name = "random".into();
                 s.reflector.aperture_diameter_m = d;
@@ -210,7 +200,7 @@ fn random_scene() -> impl Strategy<Value = Scene> {
 }
 
 proptest! {
-    #![proptest_config(config(32, 0x5eed_0003))]
+    #![proptest_config(common::proptest_config(32, 0x5eed_0003))]
 
     /// Every scene of the documented ranges validates and builds, the forward
     /// solve of its initial q balances, and its `lp` design converges with

@@ -3,24 +3,19 @@
 //! model; the response follows the stiffnesses as the physics says; the rods
 //! are named as documented; bad tables are refused naming file and line.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use ringmesh::effects::SceneEffects;
-use ringmesh::fdm::solve_network;
-use ringmesh::geometry::{build_mesh, ReflectorMesh};
+use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::Section;
 use ringmesh::scene::{Scene, SceneError, TrussModel};
 use ringmesh::truss::{self, RingTruss, RodKind, RodProperties, TrussRod};
 
 fn small_hex() -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml");
+    let path = common::problem("small-hex.toml");
     Scene::read(&path).expect("shipped scene")
-}
-
-/// The pull of the scene's net (forward FDM with its initial q) on the hinges.
-fn net_pull(mesh: &ReflectorMesh) -> Vec<[f64; 3]> {
-    let (_, eq) = solve_network(&mesh.network).expect("net solves");
-    eq.reactions_n.iter().map(|r| r.map(|v| -v)).collect()
 }
 
 fn nominal(scene: &Scene) -> Section {
@@ -87,17 +82,6 @@ fn work(loads: &[[f64; 3]], u: &[[f64; 3]]) -> f64 {
         .sum()
 }
 
-fn max_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    a.iter()
-        .zip(b)
-        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
-        .fold(0.0, f64::max)
-}
-
-fn scaled(loads: &[[f64; 3]], s: f64) -> Vec<[f64; 3]> {
-    loads.iter().map(|l| l.map(|v| v * s)).collect()
-}
-
 /// Doubling every stiffness of every rod doubles the frame's stiffness
 /// matrix, while the joints and supports are kinematic: `2K u' = f` and
 /// `u' = u/2` exactly for the linear model. For the exact model the same
@@ -111,7 +95,7 @@ fn scaled(loads: &[[f64; 3]], s: f64) -> Vec<[f64; 3]> {
 fn every_rod_twice_as_stiff_halves_the_linear_displacement_and_is_the_exact_truss_at_half_load() {
     let scene = small_hex();
     let mesh = build_mesh(&scene).unwrap();
-    let pull = net_pull(&mesh);
+    let pull = common::net_pull(&mesh);
     let stiff = with_table(
         &scene,
         &scaled_table(&scene, &RodKind::ALL, [2.0, 2.0, 2.0, 2.0]),
@@ -125,7 +109,7 @@ fn every_rod_twice_as_stiff_halves_the_linear_displacement_and_is_the_exact_trus
     let u2 = displacements(&stiff, TrussModel::Linear, &pull);
     let scale = largest(&u);
     let halved: Vec<[f64; 3]> = u.iter().map(|d| d.map(|v| 0.5 * v)).collect();
-    let error = max_difference(&u2, &halved);
+    let error = common::max_abs_diff(&u2, &halved);
     println!(
         "linear: largest displacement {scale:.4e} m → {:.4e} m, {error:.1e} m off u/2",
         largest(&u2)
@@ -136,10 +120,10 @@ fn every_rod_twice_as_stiff_halves_the_linear_displacement_and_is_the_exact_trus
         "linear: {error:e} m off u/2 (displacement {scale:e} m)"
     );
 
-    let e = displacements(&scene, TrussModel::Exact, &scaled(&pull, 0.5));
+    let e = displacements(&scene, TrussModel::Exact, &common::scaled(&pull, 0.5));
     let e2 = displacements(&stiff, TrussModel::Exact, &pull);
     let exact_scale = largest(&e2);
-    let error = max_difference(&e2, &e);
+    let error = common::max_abs_diff(&e2, &e);
     // Both stop at the force tolerance 1e-10 of the pull.
     assert!(
         error <= 1e-6 * exact_scale,
@@ -167,7 +151,7 @@ fn every_rod_twice_as_stiff_halves_the_linear_displacement_and_is_the_exact_trus
 fn stiffer_longerons_move_the_hinges_less_and_softer_ones_more() {
     let scene = small_hex();
     let mesh = build_mesh(&scene).unwrap();
-    let pull = net_pull(&mesh);
+    let pull = common::net_pull(&mesh);
     let stiff = with_table(
         &scene,
         &scaled_table(
@@ -243,7 +227,7 @@ fn rods_are_named_by_bay_in_build_order() {
         let r = &rods[rod.index()];
         let found = [at(r.start()), at(r.end())];
         assert!(
-            max_difference(&found, &ends) <= 1e-12,
+            common::max_abs_diff(&found, &ends) <= 1e-12,
             "{rod} (rod {}) runs {found:?}, not {ends:?}",
             rod.index()
         );
@@ -293,10 +277,7 @@ fn scratch(name: &str) -> PathBuf {
 
 /// `small-hex` with `[effects] rod_properties_csv = file`, written to `dir`.
 fn write_scene(dir: &Path, file: &str) -> PathBuf {
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml"),
-    )
-    .unwrap();
+    let text = std::fs::read_to_string(common::problem("small-hex.toml")).unwrap();
     let path = dir.join("scene.toml");
     std::fs::write(
         &path,
@@ -384,10 +365,7 @@ fn max_displacement_m(json: &Path) -> f64 {
 fn truss_command_applies_the_table_and_refuses_a_bad_one() {
     let dir = scratch("cli");
     let nominal_json = dir.join("nominal.json");
-    let run = ringmesh_truss(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml"),
-        &nominal_json,
-    );
+    let run = ringmesh_truss(&common::problem("small-hex.toml"), &nominal_json);
     assert!(
         run.status.success(),
         "{}",

@@ -1,14 +1,16 @@
 //! Scene files: every shipped scene builds into a consistent mesh, and every kind
 //! of nonsense is rejected with the key at fault named.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::PathBuf;
 
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::build_mesh;
 use ringmesh::{CableGroup, Scene, SceneError};
 
 fn problems() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
+    let dir = common::problem("");
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -19,8 +21,7 @@ fn problems() -> Vec<PathBuf> {
 }
 
 fn small_hex_text() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml"))
-        .unwrap()
+    std::fs::read_to_string(common::problem("small-hex.toml")).unwrap()
 }
 
 /// Replaces the line that starts with `key =` in `text` by `key = value`.
@@ -102,8 +103,7 @@ fn every_shipped_scene_builds_and_balances() {
 /// to 0.005 × its pull; the reasons are in the scene file).
 #[test]
 fn paper_scene_carries_table_3_but_the_tubes() {
-    let scene = Scene::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/paper-26m.toml"))
-        .unwrap();
+    let scene = Scene::read(&common::problem("paper-26m.toml")).unwrap();
     assert_eq!(scene.reflector.aperture_diameter_m, 26.0);
     assert_eq!(scene.reflector.focal_length_m, 4.0);
     assert_eq!(scene.reflector.offset_m, 0.0);
@@ -231,9 +231,7 @@ fn unknown_and_missing_keys_are_named() {
 
 #[test]
 fn offset_scene_keeps_ties_vertical_and_rim_on_a_plane() {
-    let scene =
-        Scene::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-offset.toml"))
-            .unwrap();
+    let scene = Scene::read(&common::problem("small-offset.toml")).unwrap();
     let mesh = build_mesh(&scene).unwrap();
     let h = scene.reflector.offset_m;
     // Top hinges sit on the aperture circle around (h, 0).

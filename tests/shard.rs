@@ -2,26 +2,13 @@
 //! (`--shard I/N`) and joined by `merge` give exactly the rows of the
 //! unsharded run; shards of different sweeps are refused.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn ringmesh(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(args)
-        .output()
-        .expect("run ringmesh")
-}
-
-fn problem(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("problems")
-        .join(name)
-        .display()
-        .to_string()
-}
+use std::process::Output;
 
 fn succeed(args: &[&str]) -> Output {
-    let run = ringmesh(args);
+    let run = common::ringmesh(args);
     assert!(
         run.status.success(),
         "ringmesh {args:?}: {}",
@@ -37,7 +24,7 @@ fn refused(paths: &[&Path], output: &Path, needle: &str) {
     args.extend(paths.iter().map(|p| p.display().to_string()));
     args.extend(["-o".to_string(), output.display().to_string()]);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let run = ringmesh(&args);
+    let run = common::ringmesh(&args);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
     assert!(stderr.contains(needle), "{args:?}: {stderr}");
@@ -111,7 +98,7 @@ fn front_in_three_shards_merges_to_the_unsharded_rows() {
         dir.path().join("parts"),
         dir.path().join("merged"),
     );
-    let scene = problem("small-hex.toml");
+    let scene = common::problem_arg("small-hex.toml");
     let args = [
         "front",
         &scene,
@@ -151,7 +138,7 @@ fn study_in_three_shards_merges_to_the_unsharded_rows() {
         dir.path().join("parts"),
         dir.path().join("merged"),
     );
-    let scene = problem("small-hex.toml");
+    let scene = common::problem_arg("small-hex.toml");
     let args = [
         "study",
         &scene,
@@ -220,7 +207,7 @@ fn study_in_three_shards_merges_to_the_unsharded_rows() {
 fn merging_mismatched_shards_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let at = |name: &str| dir.path().join(name);
-    let hex = problem("small-hex.toml");
+    let hex = common::problem_arg("small-hex.toml");
     let front = |scene: &str, shard: &str, points: &str, out: &Path| {
         succeed(&[
             "front",
@@ -242,7 +229,12 @@ fn merging_mismatched_shards_is_refused() {
     let settings = front(&hex, "1/2", "2", &at("b"));
     refused(&[&a, &settings], &out, "settings differ");
 
-    let other_scene = front(&problem("small-offset.toml"), "1/2", "3", &at("c"));
+    let other_scene = front(
+        &common::problem_arg("small-offset.toml"),
+        "1/2",
+        "3",
+        &at("c"),
+    );
     refused(&[&a, &other_scene], &out, "scenes differ");
 
     // The same name with other values is another scene.
@@ -289,9 +281,9 @@ fn bad_shard_specifications_are_refused() {
         ("0/0", "at least 1"),
         ("1", "expected I/N"),
     ] {
-        let run = ringmesh(&[
+        let run = common::ringmesh(&[
             "front",
-            &problem("small-hex.toml"),
+            &common::problem_arg("small-hex.toml"),
             "--shard",
             spec,
             "-o",

@@ -2,31 +2,14 @@
 //! support leaves no reactions; the linear and exact models agree under tiny
 //! loads and part under the paper's; bad loads are refused.
 
+mod common;
+
 use nalgebra::Vector3;
 use ringmesh::effects::SceneEffects;
-use ringmesh::fdm::solve_network;
-use ringmesh::geometry::{build_mesh, ReflectorMesh};
+use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::{NodalLoad, StaticSettings, StaticSolver};
-use ringmesh::scene::{Scene, TrussModel};
+use ringmesh::scene::TrussModel;
 use ringmesh::truss::{self, RingTruss, TrussError};
-
-fn scene(name: &str) -> Scene {
-    let path = format!("{}/problems/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-    Scene::read(std::path::Path::new(&path)).expect("shipped scene")
-}
-
-/// The pull of the scene's net (forward FDM with its initial q) on the hinges.
-fn net_pull(mesh: &ReflectorMesh) -> Vec<[f64; 3]> {
-    let (_, eq) = solve_network(&mesh.network).expect("net solves");
-    eq.reactions_n
-        .iter()
-        .map(|r| [-r[0], -r[1], -r[2]])
-        .collect()
-}
-
-fn scaled(loads: &[[f64; 3]], s: f64) -> Vec<[f64; 3]> {
-    loads.iter().map(|l| l.map(|v| v * s)).collect()
-}
 
 fn max_displacement(positions: &[[f64; 3]], reference: &[[f64; 3]]) -> Vec<f64> {
     positions
@@ -40,9 +23,9 @@ fn max_displacement(positions: &[[f64; 3]], reference: &[[f64; 3]]) -> Vec<f64> 
 
 #[test]
 fn isostatic_ring_truss_under_self_equilibrated_pull_has_no_reactions() {
-    let scene = scene("small-hex");
+    let scene = common::scene("small-hex");
     let mesh = build_mesh(&scene).unwrap();
-    let pull = net_pull(&mesh);
+    let pull = common::net_pull(&mesh);
     let ring = RingTruss::new(&scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap();
     let loads: Vec<NodalLoad> = ring
         .attachments
@@ -109,9 +92,9 @@ fn isostatic_ring_truss_under_self_equilibrated_pull_has_no_reactions() {
 
 #[test]
 fn linear_and_exact_trusses_agree_under_tiny_loads_and_part_under_the_papers() {
-    let scene = scene("paper-26m");
+    let scene = common::scene("paper-26m");
     let mesh = build_mesh(&scene).unwrap();
-    let pull = net_pull(&mesh);
+    let pull = common::net_pull(&mesh);
     let reference: Vec<[f64; 3]> = mesh
         .truss
         .top_m
@@ -137,7 +120,7 @@ fn linear_and_exact_trusses_agree_under_tiny_loads_and_part_under_the_papers() {
         |s: f64,
          linear: &mut Box<dyn truss::TrussOracle>,
          exact: &mut Box<dyn truss::TrussOracle>| {
-            let loads = scaled(&pull, s);
+            let loads = common::scaled(&pull, s);
             let dl = max_displacement(&linear.respond(&loads).unwrap().positions_m, &reference);
             let de = exact.respond(&loads).unwrap().positions_m;
             let lin = linear.respond(&loads).unwrap().positions_m;
@@ -170,9 +153,9 @@ fn linear_and_exact_trusses_agree_under_tiny_loads_and_part_under_the_papers() {
 
 #[test]
 fn rigid_truss_never_moves_and_every_model_refuses_bad_loads() {
-    let scene = scene("small-hex");
+    let scene = common::scene("small-hex");
     let mesh = build_mesh(&scene).unwrap();
-    let pull = net_pull(&mesh);
+    let pull = common::net_pull(&mesh);
     for model in [TrussModel::Rigid, TrussModel::Linear, TrussModel::Exact] {
         let mut oracle =
             truss::oracle(model, &scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap();
@@ -204,9 +187,9 @@ fn rigid_truss_never_moves_and_every_model_refuses_bad_loads() {
 
 #[test]
 fn exact_truss_warm_start_reproduces_the_cold_solution() {
-    let scene = scene("small-hex");
+    let scene = common::scene("small-hex");
     let mesh = build_mesh(&scene).unwrap();
-    let pull = net_pull(&mesh);
+    let pull = common::net_pull(&mesh);
     let mut warm = truss::oracle(
         TrussModel::Exact,
         &scene,
@@ -214,7 +197,7 @@ fn exact_truss_warm_start_reproduces_the_cold_solution() {
         &SceneEffects::of(&scene),
     )
     .unwrap();
-    warm.respond(&scaled(&pull, 0.5)).unwrap();
+    warm.respond(&common::scaled(&pull, 0.5)).unwrap();
     let from_warm = warm.respond(&pull).unwrap().positions_m;
     let mut cold = truss::oracle(
         TrussModel::Exact,

@@ -2,33 +2,17 @@
 //! and with an independent implementation, satisfy equilibrium and bounds, and
 //! report infeasible geometry by node.
 
-use std::path::Path;
+mod common;
 
 use ringmesh::geometry::build_mesh;
 use ringmesh::uniformity::{
     Bisection, Design, Lp, SurfaceTarget, Termination, UniformityError, UniformityProblem,
     UniformitySet, UniformitySolver,
 };
-use ringmesh::{CableGroup, Network, Scene};
-
-fn scene(name: &str) -> Scene {
-    Scene::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("problems/{name}.toml")))
-        .unwrap()
-}
-
-fn front_problem(scene: &Scene) -> UniformityProblem {
-    let mesh = build_mesh(scene).unwrap();
-    UniformityProblem::from_mesh(
-        &mesh,
-        &[(CableGroup::Front, scene.front_net.mean_tension_n)],
-        scene.cables.max_force_density_n_per_m,
-    )
-    .unwrap()
-}
+use ringmesh::CableGroup;
 
 fn reference_problem() -> UniformityProblem {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference/hex5-lp.json");
-    let network = Network::read_json(&path).unwrap();
+    let network = common::reference_network();
     let edges = (0..network.n_edges())
         .filter(|&k| matches!(network.group_of(k), "front" | "boundary"))
         .collect();
@@ -70,8 +54,8 @@ fn assert_sound(problem: &UniformityProblem, design: &Design) {
 #[test]
 fn lp_and_bisection_agree_on_the_test_scenes() {
     for name in ["small-hex", "small-offset", "paper-26m"] {
-        let s = scene(name);
-        let problem = front_problem(&s);
+        let s = common::scene(name);
+        let problem = common::front_problem(&s);
         let lp = Lp.solve(&problem).unwrap();
         let bisection = Bisection::default().solve(&problem).unwrap();
         assert_sound(&problem, &lp);
@@ -117,7 +101,7 @@ fn lp_and_bisection_reproduce_the_reference_optimum() {
 
 #[test]
 fn bisection_handles_several_sets_and_loads() {
-    let s = scene("small-hex");
+    let s = common::scene("small-hex");
     let mut mesh = build_mesh(&s).unwrap();
     // A downward load on every free front node: not scale-free any more.
     let n = mesh.network.n_nodes();
@@ -156,7 +140,7 @@ fn bisection_handles_several_sets_and_loads() {
 
 #[test]
 fn tightening_epsilon_never_improves_the_ratio() {
-    let problem = front_problem(&scene("small-hex"));
+    let problem = common::front_problem(&common::scene("small-hex"));
     let mut previous = 0.0;
     for epsilon in [10.0, 3.0, 1.0, 0.3, 0.1, 0.0] {
         let design = Bisection {
@@ -176,7 +160,7 @@ fn tightening_epsilon_never_improves_the_ratio() {
 
 #[test]
 fn boundary_node_on_a_straight_chord_is_reported_infeasible_by_name() {
-    let s = scene("small-hex");
+    let s = common::scene("small-hex");
     let mut mesh = build_mesh(&s).unwrap();
     // Ring 3, sector 0, j = 1: one third along the chord from hinge 0 to hinge 1.
     let node = 1 + 6 * 3 * 2 / 2 + 1;

@@ -1,16 +1,24 @@
-//! Helpers shared by the integration tests: a deterministic random source,
-//! the shipped scenes, the net's pull on the truss, and Newton's convergence
-//! rate measured from the residual history.
+//! Helpers shared by the integration tests: the shipped problems and scenes,
+//! the reference data of `tests/data/`, the command line, a deterministic
+//! random source and proptest settings, the net's pull on the truss, and
+//! Newton's convergence rate measured from the residual history. Every test
+//! file declares `mod common;` and takes what it needs.
 #![allow(dead_code)] // each test file uses its own part
 
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
 
+use std::process::{Command, Output};
+
 use nalgebra::{UnitQuaternion, Vector3};
+use proptest::test_runner::{Config as ProptestConfig, RngSeed};
+use ringmesh::design::{scene_problem, TiedNets};
 use ringmesh::fdm::solve_network;
-use ringmesh::geometry::ReflectorMesh;
+use ringmesh::geometry::{build_mesh, ReflectorMesh};
 use ringmesh::mechanics::rotation::exp;
 use ringmesh::mechanics::{State, StaticSettings, StaticSolution, StaticSolver};
+use ringmesh::network::{CableGroup, Network};
+use ringmesh::uniformity::UniformityProblem;
 use ringmesh::Scene;
 
 /// A deterministic generator (splitmix64): the tests need variety, not entropy.
@@ -44,16 +52,91 @@ pub fn angle_between(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
     2.0 * d.imag().norm().atan2(d.w.abs())
 }
 
-/// The path of a shipped problem file.
+/// The path of a shipped problem file (`small-hex.toml`, `frames/…`).
 pub fn problem(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("problems")
         .join(name)
 }
 
+/// The crate's source folder, `src/`.
+pub fn source_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
+}
+
+/// [`problem`] as a command-line argument.
+pub fn problem_arg(name: &str) -> String {
+    problem(name).display().to_string()
+}
+
 /// A shipped scene, by name (`small-hex`).
 pub fn scene(name: &str) -> Scene {
     Scene::read(&problem(&format!("{name}.toml"))).expect("shipped scene")
+}
+
+/// small-hex: its scene, mesh and two-stage design problem (weightless).
+pub fn small_hex_nets() -> (Scene, ReflectorMesh, TiedNets) {
+    let scene = scene("small-hex");
+    let (mesh, problem) = scene_problem(&scene).expect("small-hex builds");
+    let nets = TiedNets::new(&mesh, problem).expect("small-hex's nets");
+    (scene, mesh, nets)
+}
+
+/// The front net of `scene` on its mesh, its mean tension the target.
+pub fn front_problem(scene: &Scene) -> UniformityProblem {
+    let mesh = build_mesh(scene).unwrap();
+    UniformityProblem::from_mesh(
+        &mesh,
+        &[(CableGroup::Front, scene.front_net.mean_tension_n)],
+        scene.cables.max_force_density_n_per_m,
+    )
+    .unwrap()
+}
+
+/// The reference network of an independent implementation
+/// (`tests/data/hex5-lp.json`; its origin: `tests/data/README.md`).
+pub fn reference_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/hex5-lp.json")
+}
+
+/// [`reference_path`], read.
+pub fn reference_network() -> Network {
+    Network::read_json(&reference_path()).expect("tests/data/hex5-lp.json")
+}
+
+/// Runs the `ringmesh` binary with `args` in the current directory.
+pub fn ringmesh(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(args)
+        .output()
+        .expect("run ringmesh")
+}
+
+/// Runs the `ringmesh` binary with `args` in `dir`.
+pub fn ringmesh_in(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run ringmesh")
+}
+
+/// Proptest settings: `cases` cases from the fixed `seed`, nothing persisted.
+pub fn proptest_config(cases: u32, seed: u64) -> ProptestConfig {
+    ProptestConfig {
+        cases,
+        rng_seed: RngSeed::Fixed(seed),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    }
+}
+
+/// Largest `‖p − q‖∞` over two point lists.
+pub fn max_abs_diff(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+        .fold(0.0, f64::max)
 }
 
 /// The pull of the scene's net (forward FDM with its initial q) on the hinges.
