@@ -45,17 +45,21 @@ impl Shard {
     /// `count = 0` or `index ≥ count`.
     pub fn new(index: usize, count: usize) -> Result<Shard, ShardError> {
         if count == 0 {
-            return Err(ShardError::Spec(format!(
-                "{index}/{count}: the shard count must be at least 1"
-            )));
+            return Err(ShardError::Spec {
+                given: format!("{index}/{count}"),
+                reason: "the shard count must be at least 1".into(),
+            });
         }
         if index >= count {
-            return Err(ShardError::Spec(format!(
-                "{index}/{count}: shards are numbered from 0 to {} (as $SLURM_ARRAY_TASK_ID \
-                 with --array=0-{})",
-                count - 1,
-                count - 1
-            )));
+            return Err(ShardError::Spec {
+                given: format!("{index}/{count}"),
+                reason: format!(
+                    "shards are numbered from 0 to {} (as $SLURM_ARRAY_TASK_ID with \
+                     --array=0-{})",
+                    count - 1,
+                    count - 1
+                ),
+            });
         }
         Ok(Shard { index, count })
     }
@@ -88,13 +92,15 @@ impl FromStr for Shard {
 
     /// Parses `I/N`.
     fn from_str(s: &str) -> Result<Shard, ShardError> {
-        let (i, n) = s
-            .split_once('/')
-            .ok_or_else(|| ShardError::Spec(format!("{s:?}: expected I/N, e.g. 0/4")))?;
+        let (i, n) = s.split_once('/').ok_or_else(|| ShardError::Spec {
+            given: s.to_string(),
+            reason: "expected I/N, e.g. 0/4".into(),
+        })?;
         let number = |v: &str| {
-            v.trim()
-                .parse::<usize>()
-                .map_err(|_| ShardError::Spec(format!("{s:?}: expected I/N with whole numbers")))
+            v.trim().parse::<usize>().map_err(|_| ShardError::Spec {
+                given: s.to_string(),
+                reason: "expected I/N with whole numbers".into(),
+            })
         };
         Shard::new(number(i)?, number(n)?)
     }
@@ -165,8 +171,13 @@ impl Merged {
 #[derive(Debug, thiserror::Error)]
 pub enum ShardError {
     /// A bad `--shard I/N`.
-    #[error("--shard {0}")]
-    Spec(String),
+    #[error("--shard {given:?}: {reason}")]
+    Spec {
+        /// The specification as given.
+        given: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// Reading a file or folder failed.
     #[error("reading {path}: {source}")]
     Io {
@@ -184,8 +195,11 @@ pub enum ShardError {
         reason: String,
     },
     /// No shard CSV among the paths given.
-    #[error("no shard files (*.shard-I-of-N.csv) in {0}")]
-    NoShards(String),
+    #[error("no shard files (*.shard-I-of-N.csv) in {}", list(.searched))]
+    NoShards {
+        /// The files and folders searched.
+        searched: Vec<PathBuf>,
+    },
     /// Two shards of different sweeps.
     #[error("{first} and {other} are shards of different sweeps: their {what} differ{detail}")]
     Mismatch {
@@ -316,10 +330,17 @@ pub fn find_shards(paths: &[PathBuf]) -> Result<Vec<PathBuf>, ShardError> {
         }
     }
     if found.is_empty() {
-        let shown: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-        return Err(ShardError::NoShards(shown.join(", ")));
+        return Err(ShardError::NoShards {
+            searched: paths.to_vec(),
+        });
     }
     Ok(found)
+}
+
+/// Paths joined by ", ", for messages.
+fn list(paths: &[PathBuf]) -> String {
+    let shown: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    shown.join(", ")
 }
 
 /// `<stem>.shard-I-of-N.csv`.

@@ -26,7 +26,10 @@ impl Relaxation for Damped {
 
     fn next(&mut self, x: &[f64], _image: &[f64], residual: &[f64], _xi: f64) -> Step {
         Step {
-            x: x.iter().zip(residual).map(|(c, r)| c + self.omega * r).collect(),
+            x: x.iter()
+                .zip(residual)
+                .map(|(c, r)| c + self.omega * r)
+                .collect(),
             factor: self.omega,
         }
     }
@@ -85,8 +88,14 @@ fn a_relaxation_policy_defined_outside_the_crate_runs_the_loop() {
         relaxation: RelaxationKind::Anderson,
         ..settings.clone()
     };
-    let reference = design_loop(&nets, solver.as_ref(), oracle.as_mut(), &anderson, &mut |_| {})
-        .unwrap();
+    let reference = design_loop(
+        &nets,
+        solver.as_ref(),
+        oracle.as_mut(),
+        &anderson,
+        &mut |_| {},
+    )
+    .unwrap();
     // Both within 1e-7 m of their images; the map contracts, so their
     // boundaries are a few tolerances apart at most.
     let apart = common::max_abs_diff(&toy.boundary_m, &reference.boundary_m);
@@ -116,8 +125,16 @@ fn an_effect_defined_outside_the_crate_acts_on_the_nets_and_the_loop() {
     // Loads need a solver that takes them.
     let solver = SolverKind::Bisection.build(None);
     let boundary = layout_points(&mesh.truss);
-    let d0 = plain.nets.design(solver.as_ref(), &boundary).unwrap().design;
-    let d1 = pushed.nets.design(solver.as_ref(), &boundary).unwrap().design;
+    let d0 = plain
+        .nets
+        .design(solver.as_ref(), &boundary)
+        .unwrap()
+        .design;
+    let d1 = pushed
+        .nets
+        .design(solver.as_ref(), &boundary)
+        .unwrap()
+        .design;
     assert!(
         (d1.ratio - d0.ratio).abs() <= 1e-6 * d0.ratio,
         "{} vs {}",

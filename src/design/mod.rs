@@ -48,9 +48,14 @@ use crate::uniformity::{Termination, UniformityError};
 /// The outer loop cannot go on.
 #[derive(Debug, thiserror::Error)]
 pub enum DesignError {
-    /// Invalid loop settings.
-    #[error("design loop settings: {0}")]
-    Settings(String),
+    /// An invalid loop setting.
+    #[error("design loop setting `{key}`: {reason}")]
+    Setting {
+        /// The setting (`tolerance_m`, `max_iterations`, `anderson_depth`).
+        key: &'static str,
+        /// Why the value is refused.
+        reason: String,
+    },
     /// A uniformity design failed.
     #[error("outer iteration {iteration}: {source}")]
     Uniformity {
@@ -85,7 +90,7 @@ impl DesignError {
     /// True when the input is at fault.
     pub fn is_bad_input(&self) -> bool {
         match self {
-            DesignError::Settings(_) => true,
+            DesignError::Setting { .. } => true,
             DesignError::Uniformity { source, .. } => source.is_bad_input(),
             DesignError::NoDesign { termination, .. } => *termination == Termination::Infeasible,
             DesignError::Truss { source, .. } => source.is_bad_input(),

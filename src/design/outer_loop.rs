@@ -47,20 +47,22 @@ impl LoopSettings {
     /// Anderson depth, named.
     pub fn validate(&self) -> Result<(), DesignError> {
         if !(self.tolerance_m.is_finite() && self.tolerance_m > 0.0) {
-            return Err(DesignError::Settings(format!(
-                "tolerance {} m must be finite and positive",
-                self.tolerance_m
-            )));
+            return Err(DesignError::Setting {
+                key: "tolerance_m",
+                reason: format!("{} m must be finite and positive", self.tolerance_m),
+            });
         }
         if self.max_iterations == 0 {
-            return Err(DesignError::Settings(
-                "max_iterations must be at least 1".into(),
-            ));
+            return Err(DesignError::Setting {
+                key: "max_iterations",
+                reason: "must be at least 1".into(),
+            });
         }
         if self.anderson_depth == 0 {
-            return Err(DesignError::Settings(
-                "anderson_depth must be at least 1".into(),
-            ));
+            return Err(DesignError::Setting {
+                key: "anderson_depth",
+                reason: "must be at least 1".into(),
+            });
         }
         Ok(())
     }

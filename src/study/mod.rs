@@ -60,9 +60,15 @@ use crate::verify::{verify, AssemblyTruss};
 /// A study that cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
-    /// Invalid study settings.
-    #[error("study settings: {0}")]
-    Settings(String),
+    /// An invalid study setting.
+    #[error("study setting `{key}`: {reason}")]
+    Setting {
+        /// The setting (`tolerances_m`, `elements_per_rod`, `rings`,
+        /// `max_iterations`).
+        key: &'static str,
+        /// Why the value is refused.
+        reason: String,
+    },
     /// The reference run failed: nothing can be judged.
     #[error("the study's reference run ({settings}) failed: {message}")]
     Reference {
@@ -84,7 +90,7 @@ pub enum StudyError {
 impl StudyError {
     /// True when the input is at fault.
     pub fn is_bad_input(&self) -> bool {
-        matches!(self, StudyError::Settings(_))
+        matches!(self, StudyError::Setting { .. })
     }
 }
 
@@ -246,28 +252,29 @@ impl StudySettings {
     /// A tolerance not finite and positive, elements per rod outside
     /// 1…[`MAX_ELEMENTS_PER_ROD`], fewer than 2 rings, or no outer iteration.
     pub fn validate(&self) -> Result<(), StudyError> {
-        let bad = |m: String| Err(StudyError::Settings(m));
+        let bad = |key, reason: String| Err(StudyError::Setting { key, reason });
         if let Some(t) = self
             .tolerances_m
             .iter()
             .find(|t| !(t.is_finite() && **t > 0.0))
         {
-            return bad(format!("tolerance {t} m must be finite and positive"));
+            return bad("tolerances_m", format!("{t} m must be finite and positive"));
         }
         if let Some(e) = self
             .elements_per_rod
             .iter()
             .find(|e| !(1..=MAX_ELEMENTS_PER_ROD).contains(*e))
         {
-            return bad(format!(
-                "{e} elements per rod: must be in 1…{MAX_ELEMENTS_PER_ROD}"
-            ));
+            return bad(
+                "elements_per_rod",
+                format!("{e}: must be in 1…{MAX_ELEMENTS_PER_ROD}"),
+            );
         }
         if let Some(r) = self.rings.iter().find(|r| **r < 2) {
-            return bad(format!("{r} rings: at least 2 are needed"));
+            return bad("rings", format!("{r}: at least 2 are needed"));
         }
         if self.max_iterations == 0 {
-            return bad("max_iterations must be at least 1".into());
+            return bad("max_iterations", "must be at least 1".into());
         }
         Ok(())
     }

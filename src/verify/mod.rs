@@ -32,7 +32,7 @@ use crate::mechanics::{
 };
 use crate::network::Network;
 use crate::scene::Scene;
-use crate::truss::{ExactTruss, RingTruss, RingTrussBuilder, TrussOracle};
+use crate::truss::{ExactTruss, RingTruss, RingTrussBuilder, TrussError, TrussOracle};
 use crate::uniformity::Design;
 
 /// What the cables are assembled on.
@@ -48,9 +48,35 @@ pub enum AssemblyTruss {
 /// An assembly that cannot be built or solved.
 #[derive(Debug, thiserror::Error)]
 pub enum VerifyError {
-    /// The design does not belong to the network, or the network not to the mesh.
+    /// The design does not belong to the network.
+    #[error(
+        "verification: the design has {design_cables} cables and {design_nodes} nodes, the \
+         network {network_cables} and {network_nodes}"
+    )]
+    DesignOfAnotherNetwork {
+        /// Cables of the design.
+        design_cables: usize,
+        /// Nodes of the design.
+        design_nodes: usize,
+        /// Cables of the network.
+        network_cables: usize,
+        /// Nodes of the network.
+        network_nodes: usize,
+    },
+    /// The network's fixed nodes are not the truss's attachment points.
+    #[error(
+        "verification: the network has {fixed_nodes} fixed nodes, the truss {attachments} \
+         attachment points"
+    )]
+    NetworkOfAnotherTruss {
+        /// Fixed nodes of the network.
+        fixed_nodes: usize,
+        /// Attachment points of the truss.
+        attachments: usize,
+    },
+    /// The truss that gives the assembly its starting guess failed.
     #[error("verification: {0}")]
-    Mismatch(String),
+    Truss(#[from] TrussError),
     /// The assembled model is invalid (a cable of zero length, …), named.
     #[error("assembled model: {0}")]
     Mechanics(#[from] MechanicsError),
@@ -149,13 +175,12 @@ pub fn verify(
     let clock = Instant::now();
     let n_edges = network.n_edges();
     if design.q.len() != n_edges || design.nodes_xyz_m.len() != network.n_nodes() {
-        return Err(VerifyError::Mismatch(format!(
-            "the design has {} cables and {} nodes, the network {} and {}",
-            design.q.len(),
-            design.nodes_xyz_m.len(),
-            n_edges,
-            network.n_nodes()
-        )));
+        return Err(VerifyError::DesignOfAnotherNetwork {
+            design_cables: design.q.len(),
+            design_nodes: design.nodes_xyz_m.len(),
+            network_cables: n_edges,
+            network_nodes: network.n_nodes(),
+        });
     }
     let layout = &mesh.truss;
     let hinges: Vec<[f64; 3]> = layout
@@ -165,11 +190,10 @@ pub fn verify(
         .copied()
         .collect();
     if network.fixed.len() != hinges.len() {
-        return Err(VerifyError::Mismatch(format!(
-            "the network has {} fixed nodes, the truss {} attachment points",
-            network.fixed.len(),
-            hinges.len()
-        )));
+        return Err(VerifyError::NetworkOfAnotherTruss {
+            fixed_nodes: network.fixed.len(),
+            attachments: hinges.len(),
+        });
     }
 
     let (mut b, attachments, dead_loads) = match truss {
@@ -377,8 +401,7 @@ fn truss_guess(
     let layout = &mesh.truss;
     let ring = RingTruss::new(scene, layout, effects)?;
     let scale = constraint_scale(&ring.model);
-    let mut exact =
-        ExactTruss::new(ring, layout).map_err(|e| VerifyError::Mismatch(e.to_string()))?;
+    let mut exact = ExactTruss::new(ring, layout)?;
     let pull = design.pull_n();
     Ok(match exact.respond(&pull) {
         Ok(_) => exact.state().cloned().map(|s| (s, scale)),
