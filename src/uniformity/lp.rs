@@ -10,7 +10,7 @@
 use std::time::Instant;
 
 use super::conic::{infeasible, Class, Cone, ConicProgram};
-use super::ipm::{self, IpmStatus};
+use super::ipm::{self, IpmSettings, IpmStatus};
 use super::plan::PlanReduction;
 use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
@@ -90,7 +90,7 @@ fn solve_plan(
     problem: &UniformityProblem,
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<f64>, usize), String> {
-    let solution = ipm::solve(plan.lp()).map_err(|e| e.to_string())?;
+    let solution = ipm::solve(plan.lp(), &IpmSettings::default()).map_err(|e| e.to_string())?;
     let [primal, dual, gap] = solution.residuals;
     match solution.status {
         IpmStatus::Converged => {}
