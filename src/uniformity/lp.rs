@@ -10,8 +10,8 @@
 use std::time::Instant;
 
 use super::conic::{infeasible, Class, Cone, ConicProgram};
-use super::ipm::{self, IpmSettings, IpmStatus};
-use super::plan::PlanReduction;
+use super::ipm::{self, IpmError, IpmSettings, IpmStatus};
+use super::plan::{CompletionError, PlanReduction};
 use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
 /// One LP, rescaled. Needs a homogeneous problem (no loads) with one set; the
@@ -83,14 +83,39 @@ impl UniformitySolver for Lp {
     }
 }
 
+/// Why the plan path gave way to the full problem.
+#[derive(Debug, thiserror::Error)]
+enum PlanFallback {
+    /// The interior-point method could not start.
+    #[error(transparent)]
+    Setup(#[from] IpmError),
+    /// The interior-point method stopped short of its tolerance.
+    #[error(
+        "the plan interior-point method stopped with {status:?} (relative primal residual \
+         {:.1e}, dual {:.1e}, gap {:.1e})",
+        .residuals[0],
+        .residuals[1],
+        .residuals[2]
+    )]
+    Stopped {
+        /// How it stopped.
+        status: IpmStatus,
+        /// Relative primal residual, dual residual and gap.
+        residuals: [f64; 3],
+    },
+    /// The completion is not the full optimum.
+    #[error(transparent)]
+    Completion(#[from] CompletionError),
+}
+
 /// The plan problem (interior point, `plan.rs`), completed with the ties and
 /// the rear net: unscaled `q` and iterations.
 fn solve_plan(
     plan: &PlanReduction,
     problem: &UniformityProblem,
     warnings: &mut Vec<String>,
-) -> Result<(Vec<f64>, usize), String> {
-    let solution = ipm::solve(plan.lp(), &IpmSettings::default()).map_err(|e| e.to_string())?;
+) -> Result<(Vec<f64>, usize), PlanFallback> {
+    let solution = ipm::solve(plan.lp(), &IpmSettings::default())?;
     let [primal, dual, gap] = solution.residuals;
     match solution.status {
         IpmStatus::Converged => {}
@@ -99,10 +124,10 @@ fn solve_plan(
              {primal:.1e}, dual {dual:.1e}, gap {gap:.1e})"
         )),
         status => {
-            return Err(format!(
-                "the plan interior-point method stopped with {status:?} (relative primal \
-                 residual {primal:.1e}, dual {dual:.1e}, gap {gap:.1e})"
-            ))
+            return Err(PlanFallback::Stopped {
+                status,
+                residuals: solution.residuals,
+            })
         }
     }
     Ok((plan.complete(problem, &solution.q)?, solution.iterations))
