@@ -256,9 +256,10 @@ pub fn uniformity(
         .iter()
         .find(|g| !(0..network.n_edges()).any(|k| network.group_of(k) == g.as_str()))
     {
-        return Err(UniformityError::Invalid(format!(
-            "--groups: no cable of the network is in group `{missing}`"
-        ))
+        return Err(UniformityError::invalid(
+            "--groups",
+            format!("no cable of the network is in group `{missing}`"),
+        )
         .into());
     }
     let lengths: Vec<f64> = network.edges_vectors().into_iter().map(norm3).collect();

@@ -164,10 +164,12 @@ impl UniformitySolver for Bisection {
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
         let start = Instant::now();
         if !(self.epsilon_n >= 0.0 && self.epsilon_n.is_finite()) {
-            return Err(UniformityError::Invalid(format!(
-                "epsilon {} must be ≥ 0",
-                self.epsilon_n
-            )));
+            return Err(UniformityError::Setting {
+                solver: "bisection",
+                name: "epsilon_n",
+                value: self.epsilon_n,
+                range: "finite and ≥ 0",
+            });
         }
         let mut warnings = Vec::new();
         let mut iterations = 0;
@@ -181,11 +183,9 @@ impl UniformitySolver for Bisection {
             lo = hi;
             hi *= 4.0;
             if hi > self.max_ratio {
-                return Err(UniformityError::Invalid(format!(
-                    "no design with a ratio below {} exists (positive equilibria exist, but \
-                     only more uneven ones)",
-                    self.max_ratio
-                )));
+                return Err(UniformityError::RatioLimit {
+                    max_ratio: self.max_ratio,
+                });
             }
         };
         let mut termination = Termination::Converged;

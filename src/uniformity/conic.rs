@@ -223,10 +223,10 @@ pub(crate) fn slack_nodes(problem: &UniformityProblem) -> Result<Vec<usize>, Uni
     c[m..].fill(-1.0);
     let outcome = program.solve(&c);
     if outcome.class != Class::Feasible {
-        return Err(UniformityError::Invalid(format!(
-            "the slack analysis of the prescribed geometry failed: clarabel status {}",
-            outcome.status
-        )));
+        return Err(UniformityError::SolverFailed {
+            solver: "slack analysis",
+            status: outcome.status,
+        });
     }
     let structure = problem.structure();
     let mut nodes: Vec<usize> = (0..m)

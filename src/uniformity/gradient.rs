@@ -195,10 +195,13 @@ impl Default for Gradient {
 impl Gradient {
     /// Checks the settings.
     pub fn validate(&self) -> Result<(), UniformityError> {
-        let bad = |what: &str, v: f64| {
-            Err(UniformityError::Invalid(format!(
-                "gradient solver: {what} = {v} is out of range"
-            )))
+        let bad = |name: &'static str, value: f64, range: &'static str| {
+            Err(UniformityError::Setting {
+                solver: "gradient",
+                name,
+                value,
+                range,
+            })
         };
         let non_negative = [
             ("weight", self.weight),
@@ -209,7 +212,7 @@ impl Gradient {
         ];
         for (what, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
-                return bad(what, v);
+                return bad(what, v, "finite and ≥ 0");
             }
         }
         for (what, v) in [
@@ -218,14 +221,14 @@ impl Gradient {
             ("level_weight", self.level_weight),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return bad(what, v);
+                return bad(what, v, "finite and > 0");
             }
         }
         if self.memory == 0 {
-            return bad("memory", 0.0);
+            return bad("memory", 0.0, "≥ 1");
         }
         if self.restart_iterations == 0 {
-            return bad("restart_iterations", 0.0);
+            return bad("restart_iterations", 0.0, "≥ 1");
         }
         Ok(())
     }
@@ -241,10 +244,10 @@ impl Gradient {
         self.validate()?;
         let m = problem.network().n_edges();
         if theta.len() != m {
-            return Err(UniformityError::Invalid(format!(
-                "theta has {} entries, expected {m}",
-                theta.len()
-            )));
+            return Err(UniformityError::invalid(
+                "theta",
+                format!("{} entries, expected {m}", theta.len()),
+            ));
         }
         Objective::new(self, problem).evaluate_theta(theta)
     }
@@ -1073,7 +1076,10 @@ fn minimise(
     let solver = LBFGS::new(MoreThuenteLineSearch::new(), memory)
         .with_tolerance_grad(0.0)
         .and_then(|s| s.with_tolerance_cost(0.0))
-        .map_err(|e| UniformityError::Invalid(format!("gradient solver: {e}")))?;
+        .map_err(|e| UniformityError::SolverFailed {
+            solver: "gradient",
+            status: format!("L-BFGS settings: {e}"),
+        })?;
     let recorder = Recorder {
         shared: Arc::clone(&shared),
         tolerance,
@@ -1477,7 +1483,10 @@ mod tests {
         ] {
             assert!(matches!(
                 bad.solve(&problem),
-                Err(UniformityError::Invalid(_))
+                Err(UniformityError::Setting {
+                    solver: "gradient",
+                    ..
+                })
             ));
         }
         let theta = vec![0.0; 3];

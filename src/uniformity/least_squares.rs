@@ -139,27 +139,37 @@ impl LeastSquares {
     pub fn validate(&self) -> Result<(), UniformityError> {
         if let Some(lambda) = self.lambda {
             if !(lambda.is_finite() && lambda >= 0.0) {
-                return Err(UniformityError::Invalid(format!(
-                    "least-squares: lambda {lambda} must be finite and ≥ 0"
-                )));
+                return Err(UniformityError::Setting {
+                    solver: SOLVER,
+                    name: "lambda",
+                    value: lambda,
+                    range: "finite and ≥ 0",
+                });
             }
         }
         if !(self.other_weight.is_finite() && self.other_weight > 0.0) {
-            return Err(UniformityError::Invalid(format!(
-                "least-squares: other_weight {} must be finite and > 0",
-                self.other_weight
-            )));
+            return Err(UniformityError::Setting {
+                solver: SOLVER,
+                name: "other_weight",
+                value: self.other_weight,
+                range: "finite and > 0",
+            });
         }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return Err(UniformityError::Invalid(format!(
-                "least-squares: tolerance {} must be in (0, 1)",
-                self.tolerance
-            )));
+            return Err(UniformityError::Setting {
+                solver: SOLVER,
+                name: "tolerance",
+                value: self.tolerance,
+                range: "in (0, 1)",
+            });
         }
         if self.max_refinements == 0 {
-            return Err(UniformityError::Invalid(
-                "least-squares: max_refinements must be ≥ 1 (the first solve counts)".into(),
-            ));
+            return Err(UniformityError::Setting {
+                solver: SOLVER,
+                name: "max_refinements",
+                value: 0.0,
+                range: "≥ 1 (the first solve counts)",
+            });
         }
         Ok(())
     }
@@ -823,7 +833,7 @@ mod tests {
         ] {
             assert!(matches!(
                 solver.solve(&problem),
-                Err(UniformityError::Invalid(_))
+                Err(UniformityError::Setting { solver: SOLVER, .. })
             ));
         }
     }

@@ -34,9 +34,28 @@ use crate::fdm::FdmError;
 /// A uniformity problem or solve that cannot go on.
 #[derive(Debug, thiserror::Error)]
 pub enum UniformityError {
-    /// The problem is ill-posed (empty set, bad bound, zero-length cable, …).
-    #[error("invalid uniformity problem: {0}")]
-    Invalid(String),
+    /// An input of the problem is ill-posed (an empty set, a bad bound, a
+    /// zero-length cable, a count that does not match, …).
+    #[error("invalid uniformity problem: {item}: {reason}")]
+    Invalid {
+        /// The input: `uniformity set `front``, `cable 3 (nodes [3, 1])`,
+        /// `positions`, `node 7`, …
+        item: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A solver setting is out of its range.
+    #[error("invalid `{solver}` setting: {name} = {value} must be {range}")]
+    Setting {
+        /// The solver.
+        solver: &'static str,
+        /// The setting (its field name).
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// The range it must be in.
+        range: &'static str,
+    },
     /// The solver cannot treat this kind of problem (e.g. `lp` with loads).
     #[error("the `{solver}` solver cannot solve this problem: {reason}")]
     Unsupported {
@@ -44,6 +63,16 @@ pub enum UniformityError {
         solver: &'static str,
         /// Why, and which solver can.
         reason: String,
+    },
+    /// Positive equilibria exist, but none with a ratio below the solver's
+    /// search limit.
+    #[error(
+        "no design with a ratio below {max_ratio} exists (positive equilibria exist, but only \
+         more uneven ones)"
+    )]
+    RatioLimit {
+        /// The largest ratio the solver tries.
+        max_ratio: f64,
     },
     /// No strictly positive self-stress balances the prescribed geometry.
     #[error(
@@ -72,11 +101,21 @@ pub enum UniformityError {
 }
 
 impl UniformityError {
+    /// An ill-posed input: `item` names it, `reason` says what is wrong.
+    pub(crate) fn invalid(item: impl Into<String>, reason: impl Into<String>) -> Self {
+        UniformityError::Invalid {
+            item: item.into(),
+            reason: reason.into(),
+        }
+    }
+
     /// True when the cause is the caller's input.
     pub fn is_bad_input(&self) -> bool {
         match self {
-            UniformityError::Invalid(_)
+            UniformityError::Invalid { .. }
+            | UniformityError::Setting { .. }
             | UniformityError::Unsupported { .. }
+            | UniformityError::RatioLimit { .. }
             | UniformityError::Infeasible { .. } => true,
             UniformityError::SolverFailed { .. } => false,
             UniformityError::Fdm(e) => e.is_bad_input(),
