@@ -322,7 +322,7 @@ impl TiedNets {
             .front
             .with_positions(front_nodes)?
             .with_loads(front_loads)?;
-        let mut front_design = solver.solve(&front)?;
+        let mut front_design = solver.solve(&front)?.feasible()?;
         if !solver.unique_design() {
             // A point of the optimal face that moves continuously with C.
             let bounds: Vec<f64> = front_design
@@ -330,7 +330,7 @@ impl TiedNets {
                 .iter()
                 .map(|s| s.ratio * (1.0 + SELECTION_SLACK))
                 .collect();
-            let mut selected = most_uniform(&front, &front_design.solver, &bounds)?;
+            let mut selected = most_uniform(&front, &front_design.solver, &bounds)?.feasible()?;
             selected.iterations += front_design.iterations;
             selected.warnings.splice(0..0, front_design.warnings);
             front_design = selected;

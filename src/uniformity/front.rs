@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::{SolverKind, Termination, UniformityProblem};
+use super::{Design, SolverKind, Termination, UniformityProblem};
 
 /// One design of the front.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -96,7 +96,11 @@ pub fn design_front_points(
     jobs.par_iter()
         .map(|&(solver, knob)| {
             let start = Instant::now();
-            let result = solver.build(Some(knob)).solve(problem);
+            // A point without a feasible design is a failed point, as an error is.
+            let result = solver
+                .build(Some(knob))
+                .solve(problem)
+                .and_then(Design::feasible);
             let point = match result {
                 Ok(design) => FrontPoint {
                     solver,

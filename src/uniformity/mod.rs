@@ -21,7 +21,7 @@ mod problem;
 mod selection;
 
 pub use bisection::Bisection;
-pub use design::{Design, TensionSpread, Termination};
+pub use design::{Design, SlackNodes, TensionSpread, Termination};
 pub use front::{design_front, design_front_points, front_jobs, knob_values, FrontPoint};
 pub use gradient::{Gradient, History};
 pub use least_squares::LeastSquares;
@@ -74,18 +74,18 @@ pub enum UniformityError {
         /// The largest ratio the solver tries.
         max_ratio: f64,
     },
-    /// No strictly positive self-stress balances the prescribed geometry.
-    #[error(
-        "no strictly positive force densities balance the prescribed geometry: cables at \
-         nodes {} can only be slack ({count} nodes in all; e.g. boundary nodes on a straight \
-         chord between attachments: sag the boundary inward)",
-        list(.nodes)
-    )]
+    /// A solver proved the problem infeasible where the caller needs a design
+    /// ([`Design::feasible`]): solvers themselves return such a design with
+    /// [`Termination::Infeasible`], not this error.
+    #[error("the `{solver}` solver found no feasible design: {}", .warnings.join("; "))]
     Infeasible {
-        /// The first few nodes with a cable that must be slack.
-        nodes: Vec<usize>,
-        /// How many such nodes there are.
-        count: usize,
+        /// The solver.
+        solver: String,
+        /// The nodes whose cables can only be slack, when the prescribed
+        /// geometry is the cause.
+        slack_nodes: Option<SlackNodes>,
+        /// The design's warnings, the reason among them.
+        warnings: Vec<String>,
     },
     /// The inner solver failed numerically (its status, verbatim).
     #[error("the `{solver}` solver failed: {status}")]
@@ -123,14 +123,6 @@ impl UniformityError {
     }
 }
 
-fn list(nodes: &[usize]) -> String {
-    nodes
-        .iter()
-        .map(usize::to_string)
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
 /// A strategy that turns a [`UniformityProblem`] into a [`Design`].
 pub trait UniformitySolver: Send + Sync {
     /// The name used on the command line and in reports.
@@ -139,7 +131,9 @@ pub trait UniformitySolver: Send + Sync {
     fn knob(&self) -> Option<f64> {
         None
     }
-    /// Solves the problem.
+    /// Solves the problem. A well-posed problem without a feasible `q` is a
+    /// design with [`Termination::Infeasible`] (the reason in its warnings),
+    /// not an error; an error is invalid input or a failure.
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError>;
     /// True when the design is a unique, continuous function of the problem;
     /// false for min-ratio programs, whose optimum is a face (see

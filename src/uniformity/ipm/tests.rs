@@ -58,7 +58,10 @@ fn matches_clarabel(path: &str) {
         .map(|&k| tension(k))
         .fold(f64::INFINITY, f64::min);
     let ratio = set_ratio(&problem, &solution.q);
-    let (q, _) = solve_full(&problem, &mut Vec::new()).expect("clarabel");
+    let q = solve_full(&problem, &mut Vec::new())
+        .expect("clarabel")
+        .0
+        .expect("feasible");
     let reference = set_ratio(&problem, &q);
     assert!(
         (ratio - reference).abs() <= 1e-6 * reference,
