@@ -16,7 +16,7 @@
 use std::time::Instant;
 
 use super::conic::{infeasible_design, Class, Cone, ConicProgram};
-use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
+use super::{Design, KnobRange, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
 /// What one trial of a ratio says.
 enum Trial {
@@ -174,6 +174,18 @@ impl UniformitySolver for Bisection {
 
     fn knob(&self) -> Option<f64> {
         Some(self.epsilon_n)
+    }
+
+    /// ε = 0 (exact equilibrium), then ε from 1e-3·T̄ to T̄ (N), `T̄` the
+    /// first set's target mean tension.
+    fn knob_range(&self, problem: &UniformityProblem) -> Option<KnobRange> {
+        let level = problem.sets()[0].mean_tension_n;
+        Some(KnobRange {
+            name: "epsilon_n",
+            exact: Some(0.0),
+            low: 1e-3 * level,
+            high: level,
+        })
     }
 
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {

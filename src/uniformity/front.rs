@@ -25,6 +25,31 @@ pub struct FrontPoint {
     pub outcome: Result<Termination, String>,
 }
 
+/// The accuracy knob a solver's design front sweeps, scaled to one problem
+/// ([`super::UniformitySolver::knob_range`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KnobRange {
+    /// The setting it is (`epsilon_n`, `weight`, `lambda`).
+    pub name: &'static str,
+    /// A value swept before the range, if any (bisection's exact equilibrium).
+    pub exact: Option<f64>,
+    /// The smallest value of the range …
+    pub low: f64,
+    /// … and the largest, swept evenly in log scale.
+    pub high: f64,
+}
+
+impl KnobRange {
+    /// `points` values, from accurate to uniform: the exact one (if any), then
+    /// the rest from `low` to `high`, evenly in log scale.
+    pub fn values(&self, points: usize) -> Vec<f64> {
+        let mut values: Vec<f64> = self.exact.into_iter().collect();
+        let rest = points.saturating_sub(values.len());
+        values.extend(geometric(self.low, self.high, rest));
+        values
+    }
+}
+
 /// `n` values from `lo` to `hi`, evenly spaced in log scale.
 fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     match n {
@@ -36,24 +61,13 @@ fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     }
 }
 
-/// The knob values swept for `solver`, from accurate to uniform, scaled to the
-/// problem's pretension level `T̄`:
-/// * bisection: ε = 0 (exact equilibrium) and ε from 1e-3·T̄ to T̄, N;
-/// * gradient: ratio weight from 1e-8 to 1 (the surface term is normalised,
-///   so 1e-6 is already near the exact-equilibrium design);
-/// * least squares: λ from 1e-6 to 1e2 (and the equality-constrained limit is
-///   the `lp`-like exact point, run separately).
+/// The knob values swept for `solver`, from accurate to uniform: `points`
+/// values of its [`super::UniformitySolver::knob_range`] for `problem`, or the one
+/// point `0` for a solver without a knob.
 pub fn knob_values(solver: SolverKind, problem: &UniformityProblem, points: usize) -> Vec<f64> {
-    let level = problem.sets()[0].mean_tension_n;
-    match solver {
-        SolverKind::Bisection => {
-            let mut v = vec![0.0];
-            v.extend(geometric(1e-3 * level, level, points.saturating_sub(1)));
-            v
-        }
-        SolverKind::Lp => vec![0.0],
-        SolverKind::Gradient => geometric(1e-8, 1.0, points),
-        SolverKind::LeastSquares => geometric(1e-6, 1e2, points),
+    match solver.build(None).knob_range(problem) {
+        Some(range) => range.values(points),
+        None => vec![0.0],
     }
 }
 

@@ -102,7 +102,8 @@ use faer::sparse::{CreationError, FaerError, SparseColMat, Triplet};
 use faer::{Mat, Side};
 
 use super::{
-    Design, SurfaceTarget, Termination, UniformityError, UniformityProblem, UniformitySolver,
+    Design, KnobRange, SurfaceTarget, Termination, UniformityError, UniformityProblem,
+    UniformitySolver,
 };
 use crate::algebra::norm2;
 
@@ -388,6 +389,17 @@ impl UniformitySolver for Gradient {
 
     fn knob(&self) -> Option<f64> {
         Some(self.weight)
+    }
+
+    /// The ratio weight from 1e-8 to 1: the surface term is normalised, so
+    /// 1e-6 is already near the exact-equilibrium design.
+    fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
+        Some(KnobRange {
+            name: "weight",
+            exact: None,
+            low: 1e-8,
+            high: 1.0,
+        })
     }
 
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {

@@ -81,7 +81,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
-use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
+use super::{Design, KnobRange, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
 const SOLVER: &str = "least-squares";
 
@@ -182,6 +182,17 @@ impl UniformitySolver for LeastSquares {
 
     fn knob(&self) -> Option<f64> {
         self.lambda
+    }
+
+    /// λ from 1e-6 to 1e2 (the equality-constrained limit λ → 0 is the
+    /// `lp`-like exact point, run separately).
+    fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
+        Some(KnobRange {
+            name: "lambda",
+            exact: None,
+            low: 1e-6,
+            high: 1e2,
+        })
     }
 
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {

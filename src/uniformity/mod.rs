@@ -22,7 +22,9 @@ mod selection;
 
 pub use bisection::Bisection;
 pub use design::{Design, SlackNodes, TensionSpread, Termination};
-pub use front::{design_front, design_front_points, front_jobs, knob_values, FrontPoint};
+pub use front::{
+    design_front, design_front_points, front_jobs, knob_values, FrontPoint, KnobRange,
+};
 pub use gradient::{Gradient, History};
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
@@ -129,6 +131,12 @@ pub trait UniformitySolver: Send + Sync {
     fn name(&self) -> &'static str;
     /// The accuracy knob's value (ε, weight, λ), if the solver has one.
     fn knob(&self) -> Option<f64> {
+        None
+    }
+    /// The knob's name and the range the design front sweeps for `problem`
+    /// (see [`knob_values`]), or `None` for a solver without a knob (one
+    /// point).
+    fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
         None
     }
     /// Solves the problem. A well-posed problem without a feasible `q` is a
