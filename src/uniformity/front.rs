@@ -1,15 +1,15 @@
 //! The design front (DESIGN §4): sweep each solver's accuracy knob and judge every
 //! design by its *actual* surface RMS from a forward solve with its `q`.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde::Serialize;
 
-use super::{Design, SolverKind, Termination, UniformityProblem};
+use super::{Design, SolverKind, Termination, UniformityError, UniformityProblem};
 
 /// One design of the front.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone)]
 pub struct FrontPoint {
     /// The solver.
     pub solver: SolverKind,
@@ -21,8 +21,9 @@ pub struct FrontPoint {
     pub rms_mm: f64,
     /// Wall time of the solve, s.
     pub time_s: f64,
-    /// How the solver stopped, or why it failed.
-    pub outcome: Result<Termination, String>,
+    /// How the solver stopped, or why it failed (no feasible design among
+    /// the reasons, [`Design::feasible`]).
+    pub outcome: Result<Termination, Arc<UniformityError>>,
 }
 
 /// The accuracy knob a solver's design front sweeps, scaled to one problem
@@ -130,7 +131,7 @@ pub fn design_front_points(
                     ratio: f64::NAN,
                     rms_mm: f64::NAN,
                     time_s: start.elapsed().as_secs_f64(),
-                    outcome: Err(e.to_string()),
+                    outcome: Err(Arc::new(e)),
                 },
             };
             on_point(&point);
