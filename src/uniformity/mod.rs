@@ -40,7 +40,7 @@ pub enum UniformityError {
     /// zero-length cable, a count that does not match, …).
     #[error("invalid uniformity problem: {item}: {reason}")]
     Invalid {
-        /// The input: `uniformity set `front``, `cable 3 (nodes [3, 1])`,
+        /// The input: ``uniformity set `front` ``, `cable 3 (nodes [3, 1])`,
         /// `positions`, `node 7`, …
         item: String,
         /// What is wrong with it.
