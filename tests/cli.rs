@@ -201,6 +201,32 @@ fn uniformity_gradient_on_a_network_file_respects_the_bound() {
     );
 }
 
+/// A free node on the straight chord between two fixed nodes: its third cable
+/// can only be slack. No solver has a design; the error names the node.
+#[test]
+fn uniformity_on_an_infeasible_geometry_names_the_slack_node_and_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = path(&dir, "chord.json");
+    std::fs::write(
+        &input,
+        r#"{"nodes": [[0,0,0],[2,0,0],[1,1,0],[1,0,0]],
+            "edges": [[3,0],[3,1],[3,2]], "fixed": [0,1,2], "q": [1,1,1]}"#,
+    )
+    .unwrap();
+    let out = path(&dir, "q.json");
+    for solver in ["lp", "bisection"] {
+        let args = [
+            "uniformity",
+            input.to_str().unwrap(),
+            "--solver",
+            solver,
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        assert_rejected(&args, &out, "cables at nodes 3 can only be slack");
+    }
+}
+
 #[test]
 fn uniformity_on_the_reference_network_reproduces_its_optimum() {
     let dir = tempfile::tempdir().unwrap();

@@ -702,7 +702,7 @@ fn degenerate_geometry_is_refused_naming_the_entry() {
     };
     let error = UniformityProblem::new(net, vec![set], vec![3], SurfaceTarget::Prescribed, 1e3)
         .unwrap_err();
-    assert!(matches!(error, UniformityError::Invalid(_)));
+    assert!(matches!(error, UniformityError::Invalid { .. }));
     let message = error.to_string();
     assert!(
         message.contains("cable 1") && message.contains("[3, 1]"),

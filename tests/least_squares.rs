@@ -307,6 +307,7 @@ fn positivity_failure_is_reported_naming_the_cables() {
     assert!(message.contains("cable 3 (all, nodes 0–4)"), "{message}");
     // Not an infeasible geometry: the LP finds strictly positive force densities.
     let design = Lp.solve(&problem).unwrap();
+    assert_eq!(design.termination, Termination::Converged);
     assert!(design.q.iter().all(|&q| q > 0.0));
     // And Tikhonov with a large λ stays near the (positive) targets.
     let design = LeastSquares {

@@ -104,10 +104,6 @@ pub struct TiedDesign {
     pub alpha: f64,
 }
 
-fn invalid(reason: impl Into<String>) -> UniformityError {
-    UniformityError::Invalid(reason.into())
-}
-
 impl TiedNets {
     /// The split of `mesh`'s network; `full` is the scene's uniformity problem
     /// on that network (its sets must lie in the front net).
@@ -139,8 +135,9 @@ impl TiedNets {
             }
         });
         if !mirrored || !vertical || 2 * n_front_cables + ties.len() != network.n_edges() {
-            return Err(invalid(
-                "the network is not a reflector mesh (front net, mirrored rear net, vertical ties)",
+            return Err(UniformityError::invalid(
+                "network",
+                "not a reflector mesh (front net, mirrored rear net, vertical ties)",
             ));
         }
         if let Some(set) = full
@@ -148,11 +145,11 @@ impl TiedNets {
             .iter()
             .find(|s| s.edges.iter().any(|&k| k >= n_front_cables))
         {
-            return Err(invalid(format!(
-                "uniformity set `{}` has cables outside the front net: the outer loop designs \
-                 the front net and lets the rear net follow (q_rear ≈ α q_front)",
-                set.name
-            )));
+            return Err(UniformityError::invalid(
+                format!("uniformity set `{}`", set.name),
+                "cables outside the front net: the outer loop designs the front net and lets \
+                 the rear net follow (q_rear ≈ α q_front)",
+            ));
         }
 
         // Stage 1: front nodes 0..n_front, then one anchor per tie.
@@ -238,11 +235,14 @@ impl TiedNets {
         let clock = Instant::now();
         let network = self.full.network();
         if boundary_m.len() != network.fixed.len() {
-            return Err(invalid(format!(
-                "{} boundary points given, {} attachment points expected",
-                boundary_m.len(),
-                network.fixed.len()
-            )));
+            return Err(UniformityError::invalid(
+                "boundary",
+                format!(
+                    "{} points given, {} attachment points expected",
+                    boundary_m.len(),
+                    network.fixed.len()
+                ),
+            ));
         }
         let n_front = self.n_front;
         // The plan grid rebuilt on the top hinges' plan positions: the free
@@ -319,7 +319,7 @@ impl TiedNets {
             .front
             .with_positions(front_nodes)?
             .with_loads(front_loads)?;
-        let mut front_design = solver.solve(&front)?;
+        let mut front_design = solver.solve(&front)?.feasible()?;
         if !solver.unique_design() {
             // A point of the optimal face that moves continuously with C.
             let bounds: Vec<f64> = front_design
@@ -327,7 +327,7 @@ impl TiedNets {
                 .iter()
                 .map(|s| s.ratio * (1.0 + SELECTION_SLACK))
                 .collect();
-            let mut selected = most_uniform(&front, &front_design.solver, &bounds)?;
+            let mut selected = most_uniform(&front, &front_design.solver, &bounds)?.feasible()?;
             selected.iterations += front_design.iterations;
             selected.warnings.splice(0..0, front_design.warnings);
             front_design = selected;
@@ -357,11 +357,14 @@ impl TiedNets {
         for (t, &(k, i, r)) in self.ties.iter().enumerate() {
             let length = whole[i][2] - whole[r][2];
             if length.is_nan() || length <= 0.0 {
-                return Err(invalid(format!(
-                    "tie {k}: the rear node {r} rises to {:.4} m, above front node {i} at \
-                     {:.4} m — the rear net is too slack for this boundary",
-                    whole[r][2], whole[i][2]
-                )));
+                return Err(UniformityError::invalid(
+                    format!("tie {k}"),
+                    format!(
+                        "the rear node {r} rises to {:.4} m, above front node {i} at {:.4} m — \
+                         the rear net is too slack for this boundary",
+                        whole[r][2], whole[i][2]
+                    ),
+                ));
             }
             q[k] = front_design.tensions_n[n + t] / length;
         }
@@ -472,14 +475,17 @@ impl TiedNets {
             .filter(|&k| q[k].is_nan() || q[k] <= 0.0)
             .collect();
         if !negative.is_empty() {
-            return Err(invalid(format!(
-                "rear-net cables {:?} cannot stay in tension with the deformed bottom hinges",
-                negative
-                    .iter()
-                    .take(8)
-                    .map(|k| k + self.n_front_cables)
-                    .collect::<Vec<_>>()
-            )));
+            return Err(UniformityError::invalid(
+                format!(
+                    "rear-net cables {:?}",
+                    negative
+                        .iter()
+                        .take(8)
+                        .map(|k| k + self.n_front_cables)
+                        .collect::<Vec<_>>()
+                ),
+                "cannot stay in tension with the deformed bottom hinges",
+            ));
         }
         Ok(q)
     }

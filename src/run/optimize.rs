@@ -29,7 +29,7 @@ pub fn optimize(
 ) -> Result<(Design, Vec<PathBuf>), Error> {
     let scene = Scene::read(scene_path)?;
     let (mesh, problem) = scene_problem(&scene)?;
-    let design = solver.build(None).solve(&problem)?;
+    let design = solver.build(None).solve(&problem)?.feasible()?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     let csv = cables_csv(&mesh.network, &design, &scene.cables);
     let (json_path, csv_path) = (dir.join("design.json"), dir.join("cables.csv"));

@@ -61,9 +61,10 @@ pub fn uniformity(
         .iter()
         .find(|g| !(0..network.n_edges()).any(|k| network.group_of(k) == g.as_str()))
     {
-        return Err(UniformityError::Invalid(format!(
-            "--groups: no cable of the network is in group `{missing}`"
-        ))
+        return Err(UniformityError::invalid(
+            "--groups",
+            format!("no cable of the network is in group `{missing}`"),
+        )
         .into());
     }
     let lengths: Vec<f64> = network.edges_vectors().into_iter().map(norm3).collect();
@@ -96,7 +97,7 @@ pub fn uniformity(
         SurfaceTarget::Prescribed,
         max_force_density_n_per_m,
     )?;
-    let design = solver.build(None).solve(&problem)?;
+    let design = solver.build(None).solve(&problem)?.feasible()?;
     let output = UniformityOutput {
         ratio: design.ratio,
         max_residual: design.max_residual_n,

@@ -10,12 +10,23 @@
 //! stays well conditioned right at the optimal ratio (a plain feasibility problem
 //! degenerates there); the trial ratio is feasible iff `σ* ≤ 0`. A geometry with
 //! no strictly positive equilibrium makes the elastic form itself infeasible,
-//! which clarabel's status reports at the first trial.
+//! which clarabel's status reports at the first trial: the design is then
+//! [`Termination::Infeasible`], its warnings naming the slack nodes.
 
 use std::time::Instant;
 
-use super::conic::{infeasible, Class, Cone, ConicProgram};
-use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
+use super::conic::{infeasible_design, Class, Cone, ConicProgram};
+use super::{Design, KnobRange, Termination, UniformityError, UniformityProblem, UniformitySolver};
+
+/// What one trial of a ratio says.
+enum Trial {
+    /// The ratio is attainable: the trial's `q`.
+    Feasible(Vec<f64>),
+    /// The ratio is below the optimum.
+    TooLow,
+    /// No strictly positive `q` balances the geometry at any ratio.
+    NoPositiveEquilibrium,
+}
 
 /// Ratio bisection over LP (ε = 0) or SOCP (ε > 0) feasibility.
 #[derive(Debug, Clone)]
@@ -103,14 +114,14 @@ impl Bisection {
         program.solve(&c)
     }
 
-    /// Runs a trial: `Ok(Some(q))` when ratio `r` is feasible, `Ok(None)` when not.
+    /// Runs the trial of ratio `r`.
     fn feasible(
         &self,
         problem: &UniformityProblem,
         r: f64,
         iterations: &mut usize,
         warnings: &mut Vec<String>,
-    ) -> Result<Option<Vec<f64>>, UniformityError> {
+    ) -> Result<Trial, UniformityError> {
         let m = problem.network().n_edges();
         let outcome = self.trial(problem, r);
         *iterations += 1;
@@ -118,9 +129,13 @@ impl Bisection {
         match outcome.class {
             Class::Feasible => {
                 let sigma = outcome.x[m + problem.sets().len()];
-                Ok((sigma <= 0.0).then(|| outcome.x[..m].to_vec()))
+                Ok(if sigma <= 0.0 {
+                    Trial::Feasible(outcome.x[..m].to_vec())
+                } else {
+                    Trial::TooLow
+                })
             }
-            Class::Infeasible => Err(infeasible(problem)),
+            Class::Infeasible => Ok(Trial::NoPositiveEquilibrium),
             Class::Failed => Err(UniformityError::SolverFailed {
                 solver: "bisection",
                 status: format!("at ratio {r}: {}", outcome.status),
@@ -161,31 +176,49 @@ impl UniformitySolver for Bisection {
         Some(self.epsilon_n)
     }
 
+    /// ε = 0 (exact equilibrium), then ε from 1e-3·T̄ to T̄ (N), `T̄` the
+    /// first set's target mean tension.
+    fn knob_range(&self, problem: &UniformityProblem) -> Option<KnobRange> {
+        let level = problem.sets()[0].mean_tension_n;
+        Some(KnobRange {
+            name: "epsilon_n",
+            exact: Some(0.0),
+            low: 1e-3 * level,
+            high: level,
+        })
+    }
+
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
         let start = Instant::now();
         if !(self.epsilon_n >= 0.0 && self.epsilon_n.is_finite()) {
-            return Err(UniformityError::Invalid(format!(
-                "epsilon {} must be ≥ 0",
-                self.epsilon_n
-            )));
+            return Err(UniformityError::Setting {
+                solver: "bisection",
+                name: "epsilon_n",
+                value: self.epsilon_n,
+                range: "finite and ≥ 0",
+            });
         }
         let mut warnings = Vec::new();
         let mut iterations = 0;
         let (mut lo, mut hi) = (1.0, 2.0);
         // Grow the bracket until a trial is feasible.
         let mut best = loop {
-            if let Some(q) = self.feasible(problem, hi, &mut iterations, &mut warnings)? {
-                hi = Self::achieved_ratio(problem, &q).min(hi);
-                break q;
+            match self.feasible(problem, hi, &mut iterations, &mut warnings)? {
+                Trial::Feasible(q) => {
+                    hi = Self::achieved_ratio(problem, &q).min(hi);
+                    break q;
+                }
+                Trial::TooLow => {}
+                Trial::NoPositiveEquilibrium => {
+                    return infeasible_design(problem, self.name(), iterations, start, warnings)
+                }
             }
             lo = hi;
             hi *= 4.0;
             if hi > self.max_ratio {
-                return Err(UniformityError::Invalid(format!(
-                    "no design with a ratio below {} exists (positive equilibria exist, but \
-                     only more uneven ones)",
-                    self.max_ratio
-                )));
+                return Err(UniformityError::RatioLimit {
+                    max_ratio: self.max_ratio,
+                });
             }
         };
         let mut termination = Termination::Converged;
@@ -196,11 +229,14 @@ impl UniformitySolver for Bisection {
             }
             let r = 0.5 * (lo + hi);
             match self.feasible(problem, r, &mut iterations, &mut warnings)? {
-                Some(q) => {
+                Trial::Feasible(q) => {
                     hi = Self::achieved_ratio(problem, &q).clamp(lo, r);
                     best = q;
                 }
-                None => lo = r,
+                Trial::TooLow => lo = r,
+                Trial::NoPositiveEquilibrium => {
+                    return infeasible_design(problem, self.name(), iterations, start, warnings)
+                }
             }
         }
         let q = best;

@@ -2,12 +2,14 @@
 //! block by block, the equilibrium rows `A(x) q = p`, status classification, and
 //! the slack analysis that names the nodes of an infeasible geometry.
 
+use std::time::Instant;
+
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
-use super::{UniformityError, UniformityProblem};
+use super::{Design, SlackNodes, Termination, UniformityError, UniformityProblem};
 
 /// Constraint rows `s = b − A x`, grouped into cones in order.
 #[derive(Debug, Default)]
@@ -204,11 +206,15 @@ impl ConicOutcome {
     }
 }
 
+/// How many slack nodes a design names.
+const SHOWN_SLACK_NODES: usize = 12;
+
 /// Names the nodes of a geometry with no strictly positive self-stress: solves
 /// `max Σ y_k` s.t. `A q = p`, `ℓ_k q_k ≥ y_k`, `0 ≤ y_k ≤ 1` — cables with
 /// `y_k < ½` at the optimum are slack in every equilibrium — and returns the
-/// free nodes at their ends (ascending).
-pub(crate) fn slack_nodes(problem: &UniformityProblem) -> Result<Vec<usize>, UniformityError> {
+/// free nodes at their ends (ascending; none when the geometry has strictly
+/// positive equilibria).
+pub(crate) fn slack_nodes(problem: &UniformityProblem) -> Result<SlackNodes, UniformityError> {
     let m = problem.network().n_edges();
     let lengths = problem.lengths_m();
     let mut program = ConicProgram::new(2 * m);
@@ -223,10 +229,10 @@ pub(crate) fn slack_nodes(problem: &UniformityProblem) -> Result<Vec<usize>, Uni
     c[m..].fill(-1.0);
     let outcome = program.solve(&c);
     if outcome.class != Class::Feasible {
-        return Err(UniformityError::Invalid(format!(
-            "the slack analysis of the prescribed geometry failed: clarabel status {}",
-            outcome.status
-        )));
+        return Err(UniformityError::SolverFailed {
+            solver: "slack analysis",
+            status: outcome.status,
+        });
     }
     let structure = problem.structure();
     let mut nodes: Vec<usize> = (0..m)
@@ -236,16 +242,52 @@ pub(crate) fn slack_nodes(problem: &UniformityProblem) -> Result<Vec<usize>, Uni
         .collect();
     nodes.sort_unstable();
     nodes.dedup();
-    Ok(nodes)
+    Ok(SlackNodes {
+        count: nodes.len(),
+        nodes: nodes.into_iter().take(SHOWN_SLACK_NODES).collect(),
+    })
 }
 
-/// The infeasibility error for `problem`, naming its slack nodes.
-pub(crate) fn infeasible(problem: &UniformityProblem) -> UniformityError {
-    match slack_nodes(problem) {
-        Ok(nodes) => UniformityError::Infeasible {
-            count: nodes.len(),
-            nodes: nodes.into_iter().take(12).collect(),
-        },
-        Err(e) => e,
-    }
+/// The design of a conic solver that found its program infeasible: the
+/// network's own `q`, judged like any design, with [`Termination::Infeasible`]
+/// and the slack analysis (the nodes whose cables can only be slack) in its
+/// warnings and its `slack_nodes`. When the geometry does have strictly
+/// positive equilibria, the warning says that the solver's bounds exclude them.
+pub(crate) fn infeasible_design(
+    problem: &UniformityProblem,
+    solver: &str,
+    iterations: usize,
+    start: Instant,
+    mut warnings: Vec<String>,
+) -> Result<Design, UniformityError> {
+    let slack = match slack_nodes(problem) {
+        Ok(slack) if slack.count > 0 => {
+            warnings.push(slack.to_string());
+            Some(slack)
+        }
+        Ok(_) => {
+            warnings.push(format!(
+                "the `{solver}` program is infeasible, but strictly positive force densities \
+                 balance the prescribed geometry: its bounds exclude them"
+            ));
+            None
+        }
+        Err(e) => {
+            warnings.push(format!(
+                "the `{solver}` program is infeasible; naming the slack nodes failed: {e}"
+            ));
+            None
+        }
+    };
+    let mut design = Design::evaluate(
+        problem,
+        solver,
+        problem.network().q.clone(),
+        Termination::Infeasible,
+        iterations,
+        start.elapsed(),
+        warnings,
+    )?;
+    design.slack_nodes = slack;
+    Ok(design)
 }

@@ -1,6 +1,10 @@
 //! What every uniformity solver returns: a [`Design`] judged the same way for all
-//! of them, by a forward FDM solve with the returned `q`.
+//! of them, by a forward FDM solve with the returned `q`. A problem a solver
+//! proves infeasible is a design too, with [`Termination::Infeasible`] and the
+//! reason in its warnings (and [`SlackNodes`]); [`Design::feasible`] turns it
+//! into an error for callers that cannot go on without one.
 
+use std::fmt;
 use std::time::Duration;
 
 use serde::Serialize;
@@ -22,6 +26,30 @@ pub enum Termination {
     Infeasible,
     /// The inner solver reported a numerical failure.
     NumericalError,
+}
+
+/// The free nodes whose cables are slack in every equilibrium of the
+/// prescribed geometry: why it has no strictly positive force densities.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct SlackNodes {
+    /// The first few such nodes, ascending.
+    pub nodes: Vec<usize>,
+    /// How many there are.
+    pub count: usize,
+}
+
+impl fmt::Display for SlackNodes {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let nodes: Vec<String> = self.nodes.iter().map(usize::to_string).collect();
+        write!(
+            f,
+            "no strictly positive force densities balance the prescribed geometry: cables at \
+             nodes {} can only be slack ({} nodes in all; e.g. boundary nodes on a straight \
+             chord between attachments: sag the boundary inward)",
+            nodes.join(", "),
+            self.count
+        )
+    }
 }
 
 /// Tension statistics of a set of cables.
@@ -66,7 +94,8 @@ impl TensionSpread {
 pub struct Design {
     /// The solver that made it.
     pub solver: String,
-    /// Force densities, N/m: n_edges.
+    /// Force densities, N/m: n_edges (the network's own when the solver
+    /// found no feasible `q`, see [`Termination::Infeasible`]).
     pub q: Vec<f64>,
     /// Tensions of the forward solve with `q`, N: n_edges.
     pub tensions_n: Vec<f64>,
@@ -98,6 +127,10 @@ pub struct Design {
     pub time_s: f64,
     /// Everything the inner solvers reported other than plain success.
     pub warnings: Vec<String>,
+    /// When the prescribed geometry has no strictly positive force densities:
+    /// the nodes whose cables can only be slack (also in `warnings`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slack_nodes: Option<SlackNodes>,
 }
 
 impl Design {
@@ -105,6 +138,24 @@ impl Design {
     /// the loads a truss oracle takes.
     pub fn pull_n(&self) -> Vec<[f64; 3]> {
         self.reactions_n.iter().map(|r| r.map(|v| -v)).collect()
+    }
+
+    /// The design, or, when its solver proved the problem infeasible, the
+    /// [`UniformityError::Infeasible`] that says why (its warnings and slack
+    /// nodes): for callers that cannot go on without a design.
+    ///
+    /// # Errors
+    /// A design with [`Termination::Infeasible`].
+    pub fn feasible(self) -> Result<Design, UniformityError> {
+        if self.termination == Termination::Infeasible {
+            Err(UniformityError::Infeasible {
+                solver: self.solver,
+                slack_nodes: self.slack_nodes,
+                warnings: self.warnings,
+            })
+        } else {
+            Ok(self)
+        }
     }
 
     /// Judges `q` on `problem`: forward solve, tensions, spreads, residual, surface
@@ -163,6 +214,7 @@ impl Design {
             iterations,
             time_s: elapsed.as_secs_f64(),
             warnings,
+            slack_nodes: None,
         })
     }
 }

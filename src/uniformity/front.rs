@@ -1,15 +1,15 @@
 //! The design front (DESIGN §4): sweep each solver's accuracy knob and judge every
 //! design by its *actual* surface RMS from a forward solve with its `q`.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde::Serialize;
 
-use super::{SolverKind, Termination, UniformityProblem};
+use super::{Design, SolverKind, Termination, UniformityError, UniformityProblem};
 
 /// One design of the front.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone)]
 pub struct FrontPoint {
     /// The solver.
     pub solver: SolverKind,
@@ -21,8 +21,34 @@ pub struct FrontPoint {
     pub rms_mm: f64,
     /// Wall time of the solve, s.
     pub time_s: f64,
-    /// How the solver stopped, or why it failed.
-    pub outcome: Result<Termination, String>,
+    /// How the solver stopped, or why it failed (no feasible design among
+    /// the reasons, [`Design::feasible`]).
+    pub outcome: Result<Termination, Arc<UniformityError>>,
+}
+
+/// The accuracy knob a solver's design front sweeps, scaled to one problem
+/// ([`super::UniformitySolver::knob_range`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KnobRange {
+    /// The setting it is (`epsilon_n`, `weight`, `lambda`).
+    pub name: &'static str,
+    /// A value swept before the range, if any (bisection's exact equilibrium).
+    pub exact: Option<f64>,
+    /// The smallest value of the range …
+    pub low: f64,
+    /// … and the largest, swept evenly in log scale.
+    pub high: f64,
+}
+
+impl KnobRange {
+    /// `points` values, from accurate to uniform: the exact one (if any), then
+    /// the rest from `low` to `high`, evenly in log scale.
+    pub fn values(&self, points: usize) -> Vec<f64> {
+        let mut values: Vec<f64> = self.exact.into_iter().collect();
+        let rest = points.saturating_sub(values.len());
+        values.extend(geometric(self.low, self.high, rest));
+        values
+    }
 }
 
 /// `n` values from `lo` to `hi`, evenly spaced in log scale.
@@ -36,24 +62,13 @@ fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     }
 }
 
-/// The knob values swept for `solver`, from accurate to uniform, scaled to the
-/// problem's pretension level `T̄`:
-/// * bisection: ε = 0 (exact equilibrium) and ε from 1e-3·T̄ to T̄, N;
-/// * gradient: ratio weight from 1e-8 to 1 (the surface term is normalised,
-///   so 1e-6 is already near the exact-equilibrium design);
-/// * least squares: λ from 1e-6 to 1e2 (and the equality-constrained limit is
-///   the `lp`-like exact point, run separately).
+/// The knob values swept for `solver`, from accurate to uniform: `points`
+/// values of its [`super::UniformitySolver::knob_range`] for `problem`, or the one
+/// point `0` for a solver without a knob.
 pub fn knob_values(solver: SolverKind, problem: &UniformityProblem, points: usize) -> Vec<f64> {
-    let level = problem.sets()[0].mean_tension_n;
-    match solver {
-        SolverKind::Bisection => {
-            let mut v = vec![0.0];
-            v.extend(geometric(1e-3 * level, level, points.saturating_sub(1)));
-            v
-        }
-        SolverKind::Lp => vec![0.0],
-        SolverKind::Gradient => geometric(1e-8, 1.0, points),
-        SolverKind::LeastSquares => geometric(1e-6, 1e2, points),
+    match solver.build(None).knob_range(problem) {
+        Some(range) => range.values(points),
+        None => vec![0.0],
     }
 }
 
@@ -96,7 +111,11 @@ pub fn design_front_points(
     jobs.par_iter()
         .map(|&(solver, knob)| {
             let start = Instant::now();
-            let result = solver.build(Some(knob)).solve(problem);
+            // A point without a feasible design is a failed point, as an error is.
+            let result = solver
+                .build(Some(knob))
+                .solve(problem)
+                .and_then(Design::feasible);
             let point = match result {
                 Ok(design) => FrontPoint {
                     solver,
@@ -112,7 +131,7 @@ pub fn design_front_points(
                     ratio: f64::NAN,
                     rms_mm: f64::NAN,
                     time_s: start.elapsed().as_secs_f64(),
-                    outcome: Err(e.to_string()),
+                    outcome: Err(Arc::new(e)),
                 },
             };
             on_point(&point);

@@ -97,12 +97,15 @@ use argmin::solver::linesearch::MoreThuenteLineSearch;
 use argmin::solver::quasinewton::LBFGS;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::linalg::LltError;
+use faer::sparse::{CreationError, FaerError, SparseColMat, Triplet};
 use faer::{Mat, Side};
 
 use super::{
-    Design, SurfaceTarget, Termination, UniformityError, UniformityProblem, UniformitySolver,
+    Design, KnobRange, SurfaceTarget, Termination, UniformityError, UniformityProblem,
+    UniformitySolver,
 };
+use crate::algebra::norm2;
 
 /// Lower asymptote of the map, as a fraction of `[q]`.
 const FLOOR_FRACTION: f64 = 1e-9;
@@ -193,10 +196,13 @@ impl Default for Gradient {
 impl Gradient {
     /// Checks the settings.
     pub fn validate(&self) -> Result<(), UniformityError> {
-        let bad = |what: &str, v: f64| {
-            Err(UniformityError::Invalid(format!(
-                "gradient solver: {what} = {v} is out of range"
-            )))
+        let bad = |name: &'static str, value: f64, range: &'static str| {
+            Err(UniformityError::Setting {
+                solver: "gradient",
+                name,
+                value,
+                range,
+            })
         };
         let non_negative = [
             ("weight", self.weight),
@@ -207,7 +213,7 @@ impl Gradient {
         ];
         for (what, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
-                return bad(what, v);
+                return bad(what, v, "finite and ≥ 0");
             }
         }
         for (what, v) in [
@@ -216,14 +222,14 @@ impl Gradient {
             ("level_weight", self.level_weight),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return bad(what, v);
+                return bad(what, v, "finite and > 0");
             }
         }
         if self.memory == 0 {
-            return bad("memory", 0.0);
+            return bad("memory", 0.0, "≥ 1");
         }
         if self.restart_iterations == 0 {
-            return bad("restart_iterations", 0.0);
+            return bad("restart_iterations", 0.0, "≥ 1");
         }
         Ok(())
     }
@@ -239,10 +245,10 @@ impl Gradient {
         self.validate()?;
         let m = problem.network().n_edges();
         if theta.len() != m {
-            return Err(UniformityError::Invalid(format!(
-                "theta has {} entries, expected {m}",
-                theta.len()
-            )));
+            return Err(UniformityError::invalid(
+                "theta",
+                format!("{} entries, expected {m}", theta.len()),
+            ));
         }
         Objective::new(self, problem).evaluate_theta(theta)
     }
@@ -385,6 +391,17 @@ impl UniformitySolver for Gradient {
         Some(self.weight)
     }
 
+    /// The ratio weight from 1e-8 to 1: the surface term is normalised, so
+    /// 1e-6 is already near the exact-equilibrium design.
+    fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
+        Some(KnobRange {
+            name: "weight",
+            exact: None,
+            low: 1e-8,
+            high: 1.0,
+        })
+    }
+
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
         self.solve_with_history(problem).map(|(design, _)| design)
     }
@@ -476,10 +493,6 @@ fn soft_max(s: &[f64], beta: f64, weights: &mut [f64]) -> f64 {
         *w /= sum;
     }
     top + (sum / s.len() as f64).ln() / beta
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// The objective of one problem with one set of settings.
@@ -687,6 +700,24 @@ fn clamp(t: f64, upper: f64) -> (f64, f64) {
     }
 }
 
+/// Why `K = B W Bᵀ` of the linearised equilibrium could not be factored (the
+/// preconditioner and the projected start fall back without it).
+#[derive(Debug, thiserror::Error)]
+enum LinearisationError {
+    /// The network has no free node, so `K` is empty.
+    #[error("no free node")]
+    NoFreeNode,
+    /// Assembling `K` failed.
+    #[error("{0:?}")]
+    Assembly(CreationError),
+    /// Its symbolic factorisation failed.
+    #[error("{0:?}")]
+    Symbolic(FaerError),
+    /// Its numeric factorisation failed.
+    #[error("{0:?}")]
+    Numeric(LltError),
+}
+
 /// The linearised equilibrium of the design geometry around `q_r` (see the
 /// module documentation): `B = A(x̂) diag(q_r)`, `K = B W Bᵀ` factored once,
 /// `D_r = D(q_r)`.
@@ -709,7 +740,7 @@ struct Preconditioner {
 }
 
 impl Preconditioner {
-    fn new(problem: &UniformityProblem, q_ref: &[f64]) -> Result<Self, String> {
+    fn new(problem: &UniformityProblem, q_ref: &[f64]) -> Result<Self, LinearisationError> {
         Self::with_weights(problem, q_ref.to_vec(), q_ref)
     }
 
@@ -718,7 +749,7 @@ impl Preconditioner {
         problem: &UniformityProblem,
         q_ref: Vec<f64>,
         g: &[f64],
-    ) -> Result<Self, String> {
+    ) -> Result<Self, LinearisationError> {
         let structure = problem.structure();
         let edges: Vec<[Option<usize>; 2]> = structure
             .edges()
@@ -727,7 +758,7 @@ impl Preconditioner {
             .collect();
         let n_rows = 3 * structure.free_nodes().len();
         if n_rows == 0 {
-            return Err("no free node".into());
+            return Err(LinearisationError::NoFreeNode);
         }
         let mut freedom = vec![OTHER_FREEDOM; edges.len()];
         for set in problem.sets() {
@@ -753,7 +784,7 @@ impl Preconditioner {
     }
 
     /// Refactors `K` for new column weights `g`.
-    fn refactor(&mut self, g: &[f64]) -> Result<(), String> {
+    fn refactor(&mut self, g: &[f64]) -> Result<(), LinearisationError> {
         self.factor = factor_k(
             &self.edges,
             &self.edges_vectors,
@@ -918,7 +949,7 @@ fn factor_k(
     freedom: &[f64],
     n_rows: usize,
     g: &[f64],
-) -> Result<Llt<usize, f64>, String> {
+) -> Result<Llt<usize, f64>, LinearisationError> {
     let mut diagonal = vec![0.0; n_rows];
     let mut triplets = Vec::with_capacity(n_rows + 15 * g.len());
     let mut column: Vec<(usize, f64)> = Vec::with_capacity(6);
@@ -948,9 +979,11 @@ fn factor_k(
             .map(|(r, &d)| Triplet::new(r, r, d * (1.0 + SHIFT))),
     );
     let k = SparseColMat::try_new_from_triplets(n_rows, n_rows, &triplets)
-        .map_err(|e| format!("{e:?}"))?;
-    let symbolic = SymbolicLlt::try_new(k.symbolic(), Side::Lower).map_err(|e| format!("{e:?}"))?;
-    Llt::try_new_with_symbolic(symbolic, k.as_ref(), Side::Lower).map_err(|e| format!("{e:?}"))
+        .map_err(LinearisationError::Assembly)?;
+    let symbolic =
+        SymbolicLlt::try_new(k.symbolic(), Side::Lower).map_err(LinearisationError::Symbolic)?;
+    Llt::try_new_with_symbolic(symbolic, k.as_ref(), Side::Lower)
+        .map_err(LinearisationError::Numeric)
 }
 
 /// The solver's variables: `θ`, or the preconditioned `φ`.
@@ -998,7 +1031,7 @@ impl<'a, 'p> Variables<'a, 'p> {
             }
             None => {
                 let (j, g) = self.objective.evaluate_theta(phi)?;
-                let theta_norm = norm(&g);
+                let theta_norm = norm2(&g);
                 Ok((j, g, theta_norm))
             }
         }
@@ -1026,7 +1059,7 @@ fn minimise(
     let phi0 = variables.start.clone();
     let (j0, g0, _) = variables.evaluate(&phi0)?;
     history.evaluations += 1;
-    let g0_norm = norm(&g0);
+    let g0_norm = norm2(&g0);
     if !(j0.is_finite() && g0_norm.is_finite()) {
         return Err(UniformityError::SolverFailed {
             solver: "gradient",
@@ -1055,7 +1088,10 @@ fn minimise(
     let solver = LBFGS::new(MoreThuenteLineSearch::new(), memory)
         .with_tolerance_grad(0.0)
         .and_then(|s| s.with_tolerance_cost(0.0))
-        .map_err(|e| UniformityError::Invalid(format!("gradient solver: {e}")))?;
+        .map_err(|e| UniformityError::SolverFailed {
+            solver: "gradient",
+            status: format!("L-BFGS settings: {e}"),
+        })?;
     let recorder = Recorder {
         shared: Arc::clone(&shared),
         tolerance,
@@ -1230,7 +1266,7 @@ impl Observe<LbfgsState> for Recorder {
 /// geometry by damped Gauss–Newton steps `θ ← θ − α W Bᵀ K⁻¹ (A q(θ) − p)`
 /// (`B = A diag(dq/dθ)`): the least weighted change in `θ`, positive by
 /// construction; then scaled to the first set's level when there are no loads.
-fn projected_start(problem: &UniformityProblem, map: &Map) -> Result<Vec<f64>, String> {
+fn projected_start(problem: &UniformityProblem, map: &Map) -> Result<Vec<f64>, LinearisationError> {
     let mut q = problem.network().q.clone();
     let lengths = problem.lengths_m();
     for set in problem.sets().iter().rev() {
@@ -1257,7 +1293,7 @@ fn projected_start(problem: &UniformityProblem, map: &Map) -> Result<Vec<f64>, S
                 .collect();
             let trial_q: Vec<f64> = trial.iter().map(|&t| map.q(t)).collect();
             let trial_residual = linear.residual(&trial_q, &loads);
-            if norm(&trial_residual) < norm(&residual) {
+            if norm2(&trial_residual) < norm2(&residual) {
                 accepted = Some((trial, trial_q, trial_residual));
                 break;
             }
@@ -1289,6 +1325,7 @@ mod tests {
     use std::path::Path;
 
     use super::*;
+    use crate::algebra::dot;
     use crate::geometry::build_mesh;
     use crate::scene::Scene;
     use crate::CableGroup;
@@ -1310,10 +1347,6 @@ mod tests {
         (0..n)
             .map(|i| (((i * 7919 + seed * 104_729) % 201) as f64 - 100.0) / 100.0)
             .collect()
-    }
-
-    fn dot(a: &[f64], b: &[f64]) -> f64 {
-        a.iter().zip(b).map(|(x, y)| x * y).sum()
     }
 
     #[test]
@@ -1388,7 +1421,7 @@ mod tests {
         let loads = problem.free_loads();
         let before = p.residual(q_ref, &loads);
         let after = p.residual(&p.q_exact(&phi), &loads);
-        let change = norm(
+        let change = norm2(
             &before
                 .iter()
                 .zip(&after)
@@ -1396,7 +1429,7 @@ mod tests {
                 .collect::<Vec<_>>(),
         );
         // Without the projection, ψ alone would move it by B ψ.
-        let unprojected = norm(&p.b_times(q_ref, &phi[..m]));
+        let unprojected = norm2(&p.b_times(q_ref, &phi[..m]));
         // The shift of K leaves the near-mechanism modes partly unprojected.
         assert!(
             change <= 1e-3 * unprojected,
@@ -1462,7 +1495,10 @@ mod tests {
         ] {
             assert!(matches!(
                 bad.solve(&problem),
-                Err(UniformityError::Invalid(_))
+                Err(UniformityError::Setting {
+                    solver: "gradient",
+                    ..
+                })
             ));
         }
         let theta = vec![0.0; 3];

@@ -81,7 +81,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
-use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
+use super::{Design, KnobRange, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
 const SOLVER: &str = "least-squares";
 
@@ -139,27 +139,37 @@ impl LeastSquares {
     pub fn validate(&self) -> Result<(), UniformityError> {
         if let Some(lambda) = self.lambda {
             if !(lambda.is_finite() && lambda >= 0.0) {
-                return Err(UniformityError::Invalid(format!(
-                    "least-squares: lambda {lambda} must be finite and ≥ 0"
-                )));
+                return Err(UniformityError::Setting {
+                    solver: SOLVER,
+                    name: "lambda",
+                    value: lambda,
+                    range: "finite and ≥ 0",
+                });
             }
         }
         if !(self.other_weight.is_finite() && self.other_weight > 0.0) {
-            return Err(UniformityError::Invalid(format!(
-                "least-squares: other_weight {} must be finite and > 0",
-                self.other_weight
-            )));
+            return Err(UniformityError::Setting {
+                solver: SOLVER,
+                name: "other_weight",
+                value: self.other_weight,
+                range: "finite and > 0",
+            });
         }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return Err(UniformityError::Invalid(format!(
-                "least-squares: tolerance {} must be in (0, 1)",
-                self.tolerance
-            )));
+            return Err(UniformityError::Setting {
+                solver: SOLVER,
+                name: "tolerance",
+                value: self.tolerance,
+                range: "in (0, 1)",
+            });
         }
         if self.max_refinements == 0 {
-            return Err(UniformityError::Invalid(
-                "least-squares: max_refinements must be ≥ 1 (the first solve counts)".into(),
-            ));
+            return Err(UniformityError::Setting {
+                solver: SOLVER,
+                name: "max_refinements",
+                value: 0.0,
+                range: "≥ 1 (the first solve counts)",
+            });
         }
         Ok(())
     }
@@ -172,6 +182,17 @@ impl UniformitySolver for LeastSquares {
 
     fn knob(&self) -> Option<f64> {
         self.lambda
+    }
+
+    /// λ from 1e-6 to 1e2 (the equality-constrained limit λ → 0 is the
+    /// `lp`-like exact point, run separately).
+    fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
+        Some(KnobRange {
+            name: "lambda",
+            exact: None,
+            low: 1e-6,
+            high: 1e2,
+        })
     }
 
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
@@ -823,7 +844,7 @@ mod tests {
         ] {
             assert!(matches!(
                 solver.solve(&problem),
-                Err(UniformityError::Invalid(_))
+                Err(UniformityError::Setting { solver: SOLVER, .. })
             ));
         }
     }

@@ -3,15 +3,17 @@
 //! `ℓ_k q_k ≥ f` (f = `min_tension_fraction`), then rescaled to the target mean.
 //!
 //! A reflector mesh's front-net problem is solved as its plan problem
-//! (`plan.rs`) by the structured interior-point method (`ipm.rs`) and completed
+//! (`plan.rs`) by the structured interior-point method (`ipm/`) and completed
 //! with the ties and the rear net; any other network, or a plan solve that does
-//! not reach its tolerance, goes to clarabel on the full problem.
+//! not reach its tolerance, goes to clarabel on the full problem. A geometry
+//! with no strictly positive equilibrium makes that LP infeasible: the design
+//! is then [`Termination::Infeasible`], its warnings naming the slack nodes.
 
 use std::time::Instant;
 
-use super::conic::{infeasible, Class, Cone, ConicProgram};
-use super::ipm::{self, IpmStatus};
-use super::plan::PlanReduction;
+use super::conic::{infeasible_design, Class, Cone, ConicProgram};
+use super::ipm::{self, IpmError, IpmSettings, IpmStatus};
+use super::plan::{CompletionError, PlanReduction};
 use super::{Design, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
 /// One LP, rescaled. Needs a homogeneous problem (no loads) with one set; the
@@ -50,11 +52,17 @@ impl UniformitySolver for Lp {
         let lengths = problem.lengths_m();
         let mut warnings = Vec::new();
         let (q, iterations) = match PlanReduction::new(problem) {
-            Ok(plan) => solve_plan(&plan, problem, &mut warnings).or_else(|reason| {
-                warnings.push(format!("lp: {reason}; solved the full problem instead"));
-                solve_full(problem, &mut warnings)
-            })?,
+            Ok(plan) => match solve_plan(&plan, problem, &mut warnings) {
+                Ok((q, iterations)) => (Some(q), iterations),
+                Err(reason) => {
+                    warnings.push(format!("lp: {reason}; solved the full problem instead"));
+                    solve_full(problem, &mut warnings)?
+                }
+            },
             Err(_) => solve_full(problem, &mut warnings)?,
+        };
+        let Some(q) = q else {
+            return infeasible_design(problem, self.name(), iterations, start, warnings);
         };
         let mean: f64 =
             set.edges.iter().map(|&k| lengths[k] * q[k]).sum::<f64>() / set.edges.len() as f64;
@@ -83,14 +91,39 @@ impl UniformitySolver for Lp {
     }
 }
 
+/// Why the plan path gave way to the full problem.
+#[derive(Debug, thiserror::Error)]
+enum PlanFallback {
+    /// The interior-point method could not start.
+    #[error(transparent)]
+    Setup(#[from] IpmError),
+    /// The interior-point method stopped short of its tolerance.
+    #[error(
+        "the plan interior-point method stopped with {status:?} (relative primal residual \
+         {:.1e}, dual {:.1e}, gap {:.1e})",
+        .residuals[0],
+        .residuals[1],
+        .residuals[2]
+    )]
+    Stopped {
+        /// How it stopped.
+        status: IpmStatus,
+        /// Relative primal residual, dual residual and gap.
+        residuals: [f64; 3],
+    },
+    /// The completion is not the full optimum.
+    #[error(transparent)]
+    Completion(#[from] CompletionError),
+}
+
 /// The plan problem (interior point, `plan.rs`), completed with the ties and
 /// the rear net: unscaled `q` and iterations.
 fn solve_plan(
     plan: &PlanReduction,
     problem: &UniformityProblem,
     warnings: &mut Vec<String>,
-) -> Result<(Vec<f64>, usize), String> {
-    let solution = ipm::solve(plan.lp()).map_err(|e| e.to_string())?;
+) -> Result<(Vec<f64>, usize), PlanFallback> {
+    let solution = ipm::solve(plan.lp(), &IpmSettings::default())?;
     let [primal, dual, gap] = solution.residuals;
     match solution.status {
         IpmStatus::Converged => {}
@@ -99,21 +132,22 @@ fn solve_plan(
              {primal:.1e}, dual {dual:.1e}, gap {gap:.1e})"
         )),
         status => {
-            return Err(format!(
-                "the plan interior-point method stopped with {status:?} (relative primal \
-                 residual {primal:.1e}, dual {dual:.1e}, gap {gap:.1e})"
-            ))
+            return Err(PlanFallback::Stopped {
+                status,
+                residuals: solution.residuals,
+            })
         }
     }
     Ok((plan.complete(problem, &solution.q)?, solution.iterations))
 }
 
 /// The full problem as one conic program (clarabel): every cable, three
-/// equilibrium rows per free node. Unscaled `q` and iterations.
+/// equilibrium rows per free node. Unscaled `q` (`None` when the program is
+/// infeasible: no strictly positive `q` balances the geometry) and iterations.
 pub(super) fn solve_full(
     problem: &UniformityProblem,
     warnings: &mut Vec<String>,
-) -> Result<(Vec<f64>, usize), UniformityError> {
+) -> Result<(Option<Vec<f64>>, usize), UniformityError> {
     let set = &problem.sets()[0];
     let lengths = problem.lengths_m();
     let m = problem.network().n_edges();
@@ -137,9 +171,9 @@ pub(super) fn solve_full(
     match outcome.class {
         Class::Feasible => {
             warnings.extend(outcome.warning("lp"));
-            Ok((outcome.x[..m].to_vec(), outcome.iterations))
+            Ok((Some(outcome.x[..m].to_vec()), outcome.iterations))
         }
-        Class::Infeasible => Err(infeasible(problem)),
+        Class::Infeasible => Ok((None, outcome.iterations)),
         Class::Failed => Err(UniformityError::SolverFailed {
             solver: "lp",
             status: outcome.status,
@@ -165,7 +199,10 @@ mod tests {
             .count();
         assert_eq!(plan.lp().n_free, ties, "one plan node per tie");
         let (q_plan, _) = solve_plan(&plan, &problem, &mut Vec::new()).expect("plan");
-        let (q_full, _) = solve_full(&problem, &mut Vec::new()).expect("full");
+        let q_full = solve_full(&problem, &mut Vec::new())
+            .expect("full")
+            .0
+            .expect("feasible");
         let (plan_ratio, full_ratio) = (set_ratio(&problem, &q_plan), set_ratio(&problem, &q_full));
         assert!(
             (plan_ratio - full_ratio).abs() <= 1e-6 * full_ratio,

@@ -21,8 +21,10 @@ mod problem;
 mod selection;
 
 pub use bisection::Bisection;
-pub use design::{Design, TensionSpread, Termination};
-pub use front::{design_front, design_front_points, front_jobs, knob_values, FrontPoint};
+pub use design::{Design, SlackNodes, TensionSpread, Termination};
+pub use front::{
+    design_front, design_front_points, front_jobs, knob_values, FrontPoint, KnobRange,
+};
 pub use gradient::{Gradient, History};
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
@@ -34,9 +36,28 @@ use crate::fdm::FdmError;
 /// A uniformity problem or solve that cannot go on.
 #[derive(Debug, thiserror::Error)]
 pub enum UniformityError {
-    /// The problem is ill-posed (empty set, bad bound, zero-length cable, …).
-    #[error("invalid uniformity problem: {0}")]
-    Invalid(String),
+    /// An input of the problem is ill-posed (an empty set, a bad bound, a
+    /// zero-length cable, a count that does not match, …).
+    #[error("invalid uniformity problem: {item}: {reason}")]
+    Invalid {
+        /// The input: ``uniformity set `front` ``, `cable 3 (nodes [3, 1])`,
+        /// `positions`, `node 7`, …
+        item: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A solver setting is out of its range.
+    #[error("invalid `{solver}` setting: {name} = {value} must be {range}")]
+    Setting {
+        /// The solver.
+        solver: &'static str,
+        /// The setting (its field name).
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// The range it must be in.
+        range: &'static str,
+    },
     /// The solver cannot treat this kind of problem (e.g. `lp` with loads).
     #[error("the `{solver}` solver cannot solve this problem: {reason}")]
     Unsupported {
@@ -45,18 +66,28 @@ pub enum UniformityError {
         /// Why, and which solver can.
         reason: String,
     },
-    /// No strictly positive self-stress balances the prescribed geometry.
+    /// Positive equilibria exist, but none with a ratio below the solver's
+    /// search limit.
     #[error(
-        "no strictly positive force densities balance the prescribed geometry: cables at \
-         nodes {} can only be slack ({count} nodes in all; e.g. boundary nodes on a straight \
-         chord between attachments: sag the boundary inward)",
-        list(.nodes)
+        "no design with a ratio below {max_ratio} exists (positive equilibria exist, but only \
+         more uneven ones)"
     )]
+    RatioLimit {
+        /// The largest ratio the solver tries.
+        max_ratio: f64,
+    },
+    /// A solver proved the problem infeasible where the caller needs a design
+    /// ([`Design::feasible`]): solvers themselves return such a design with
+    /// [`Termination::Infeasible`], not this error.
+    #[error("the `{solver}` solver found no feasible design: {}", .warnings.join("; "))]
     Infeasible {
-        /// The first few nodes with a cable that must be slack.
-        nodes: Vec<usize>,
-        /// How many such nodes there are.
-        count: usize,
+        /// The solver.
+        solver: String,
+        /// The nodes whose cables can only be slack, when the prescribed
+        /// geometry is the cause.
+        slack_nodes: Option<SlackNodes>,
+        /// The design's warnings, the reason among them.
+        warnings: Vec<String>,
     },
     /// The inner solver failed numerically (its status, verbatim).
     #[error("the `{solver}` solver failed: {status}")]
@@ -72,24 +103,26 @@ pub enum UniformityError {
 }
 
 impl UniformityError {
+    /// An ill-posed input: `item` names it, `reason` says what is wrong.
+    pub(crate) fn invalid(item: impl Into<String>, reason: impl Into<String>) -> Self {
+        UniformityError::Invalid {
+            item: item.into(),
+            reason: reason.into(),
+        }
+    }
+
     /// True when the cause is the caller's input.
     pub fn is_bad_input(&self) -> bool {
         match self {
-            UniformityError::Invalid(_)
+            UniformityError::Invalid { .. }
+            | UniformityError::Setting { .. }
             | UniformityError::Unsupported { .. }
+            | UniformityError::RatioLimit { .. }
             | UniformityError::Infeasible { .. } => true,
             UniformityError::SolverFailed { .. } => false,
             UniformityError::Fdm(e) => e.is_bad_input(),
         }
     }
-}
-
-fn list(nodes: &[usize]) -> String {
-    nodes
-        .iter()
-        .map(usize::to_string)
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 /// A strategy that turns a [`UniformityProblem`] into a [`Design`].
@@ -100,7 +133,15 @@ pub trait UniformitySolver: Send + Sync {
     fn knob(&self) -> Option<f64> {
         None
     }
-    /// Solves the problem.
+    /// The knob's name and the range the design front sweeps for `problem`
+    /// (see [`knob_values`]), or `None` for a solver without a knob (one
+    /// point).
+    fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
+        None
+    }
+    /// Solves the problem. A well-posed problem without a feasible `q` is a
+    /// design with [`Termination::Infeasible`] (the reason in its warnings),
+    /// not an error; an error is invalid input or a failure.
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError>;
     /// True when the design is a unique, continuous function of the problem;
     /// false for min-ratio programs, whose optimum is a face (see

@@ -35,6 +35,82 @@ const VERTICAL: f64 = 1e-12;
 /// tension, for the completion to count as exact.
 const COMPLETION_TOLERANCE: f64 = 1e-9;
 
+/// Why a problem is not the single-set front-net problem of a reflector mesh.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(crate) enum LayoutError {
+    /// No vertical ties at the end of the cable list (or an odd count before
+    /// them when there is a rear net).
+    #[error("the network does not end with the vertical ties of a reflector mesh")]
+    NoTies,
+    /// A rear cable does not mirror its front cable.
+    #[error("cable {rear} is not the rear-net mirror of front-net cable {front}")]
+    NotMirrored {
+        /// The rear-net cable.
+        rear: usize,
+        /// The front-net cable it should mirror.
+        front: usize,
+    },
+    /// Several sets, or a set with cables outside the front net.
+    #[error("the uniformity set is not inside the front net")]
+    SetOutsideFrontNet,
+    /// A tie that does not hang below its front node.
+    #[error("tie {tie} does not join a front node to the node below it")]
+    TieMisplaced {
+        /// The tie.
+        tie: usize,
+    },
+    /// A front node with two ties.
+    #[error("front node {node} has two ties")]
+    TwoTies {
+        /// The front node.
+        node: usize,
+    },
+    /// A free front node without a tie.
+    #[error("front node {node} has no tie")]
+    NoTie {
+        /// The front node.
+        node: usize,
+    },
+}
+
+/// Why a completed plan solution is not the optimum of the full problem.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(crate) enum CompletionError {
+    /// No positive rear level balances the ties.
+    #[error(
+        "the rear net cannot balance the ties with a positive multiple of the front force \
+         densities (α = {alpha:.3e})"
+    )]
+    RearLevel {
+        /// The least-squares level found.
+        alpha: f64,
+    },
+    /// The completion does not balance the prescribed geometry.
+    #[error(
+        "the completed design leaves {residual_n:.3e} N out of balance (largest tension \
+         {max_tension_n:.3e} N): the rear net does not mirror the front net"
+    )]
+    OutOfBalance {
+        /// Largest out-of-balance force, N.
+        residual_n: f64,
+        /// Largest tension, N.
+        max_tension_n: f64,
+    },
+    /// A tie or rear cable below the tension floor.
+    #[error(
+        "cable {cable} of the completion carries {tension:.3e} of the smallest set tension, \
+         below the floor {floor}"
+    )]
+    BelowFloor {
+        /// The cable.
+        cable: usize,
+        /// Its tension per unit smallest set tension.
+        tension: f64,
+        /// The floor, `min_tension_fraction`.
+        floor: f64,
+    },
+}
+
 /// The recognised layout of a reflector mesh and its plan problem.
 #[derive(Debug, Clone)]
 pub(crate) struct PlanReduction {
@@ -51,7 +127,7 @@ pub(crate) struct PlanReduction {
 impl PlanReduction {
     /// Recognises the reflector layout in a single-set problem without loads,
     /// or says why the problem is not of that form.
-    pub(crate) fn new(problem: &UniformityProblem) -> Result<Self, String> {
+    pub(crate) fn new(problem: &UniformityProblem) -> Result<Self, LayoutError> {
         let network = problem.network();
         let m = network.n_edges();
         let u = network.edges_vectors();
@@ -66,9 +142,7 @@ impl PlanReduction {
             .iter()
             .all(|&[_, r]| structure.free_index(r).is_none());
         if n_ties == 0 || (rear && (m - n_ties) % 2 != 0) {
-            return Err(
-                "the network does not end with the vertical ties of a reflector mesh".into(),
-            );
+            return Err(LayoutError::NoTies);
         }
         let n = if rear { (m - n_ties) / 2 } else { m - n_ties };
         let first_tie = m - n_ties;
@@ -76,13 +150,13 @@ impl PlanReduction {
         if let Some(k) = (0..n).find(|&k| {
             is_vertical(k) || (rear && edges[k + n] != [edges[k][0] + offset, edges[k][1] + offset])
         }) {
-            return Err(format!(
-                "cable {} is not the rear-net mirror of front-net cable {k}",
-                k + n
-            ));
+            return Err(LayoutError::NotMirrored {
+                rear: k + n,
+                front: k,
+            });
         }
         if problem.sets().len() != 1 || problem.sets()[0].edges.iter().any(|&k| k >= n) {
-            return Err("the uniformity set is not inside the front net".into());
+            return Err(LayoutError::SetOutsideFrontNet);
         }
 
         // Plan rows: the free nodes of the front net, each with exactly one tie.
@@ -98,18 +172,16 @@ impl PlanReduction {
         let mut ties = Vec::with_capacity(n_ties);
         for (k, &[i, r]) in edges.iter().enumerate().skip(first_tie) {
             let Some(f) = local[i].filter(|_| !rear || r == i + offset) else {
-                return Err(format!(
-                    "tie {k} does not join a front node to the node below it"
-                ));
+                return Err(LayoutError::TieMisplaced { tie: k });
             };
             if std::mem::replace(&mut tied[f], true) {
-                return Err(format!("front node {i} has two ties"));
+                return Err(LayoutError::TwoTies { node: i });
             }
             ties.push((k, i, r));
         }
         if let Some(f) = tied.iter().position(|&t| !t) {
             let i = local.iter().position(|&l| l == Some(f)).unwrap_or(f);
-            return Err(format!("front node {i} has no tie"));
+            return Err(LayoutError::NoTie { node: i });
         }
 
         let mut in_set = vec![false; n];
@@ -144,7 +216,7 @@ impl PlanReduction {
         &self,
         problem: &UniformityProblem,
         q_front: &[f64],
-    ) -> Result<Vec<f64>, String> {
+    ) -> Result<Vec<f64>, CompletionError> {
         let n = self.n_front_cables;
         let network = problem.network();
         let x = &network.nodes;
@@ -164,7 +236,11 @@ impl PlanReduction {
 
     /// The rear net `q_rear = α q_front`, α from the rear nodes' vertical
     /// balance against the ties (least squares).
-    fn complete_rear(&self, network: &crate::Network, q: &mut [f64]) -> Result<(), String> {
+    fn complete_rear(
+        &self,
+        network: &crate::Network,
+        q: &mut [f64],
+    ) -> Result<(), CompletionError> {
         let n = self.n_front_cables;
         let x = &network.nodes;
         // α from the rear nodes' vertical balance: α V_r + q_t (z_i − z_r) = 0.
@@ -180,10 +256,7 @@ impl PlanReduction {
         }
         let alpha = num / den;
         if !(alpha.is_finite() && alpha > 0.0) {
-            return Err(format!(
-                "the rear net cannot balance the ties with a positive multiple of the front \
-                 force densities (α = {alpha:.3e})"
-            ));
+            return Err(CompletionError::RearLevel { alpha });
         }
         q[n..2 * n].iter_mut().for_each(|v| *v *= alpha);
         Ok(())
@@ -191,7 +264,7 @@ impl PlanReduction {
 
     /// `q` if it balances the prescribed geometry and keeps the full LP's
     /// bounds, else why not.
-    fn check(&self, problem: &UniformityProblem, q: Vec<f64>) -> Result<Vec<f64>, String> {
+    fn check(&self, problem: &UniformityProblem, q: Vec<f64>) -> Result<Vec<f64>, CompletionError> {
         let n = self.n_front_cables;
         let m = q.len();
         let lengths = problem.lengths_m();
@@ -199,18 +272,18 @@ impl PlanReduction {
         let max_tension = tensions.iter().copied().fold(0.0, f64::max);
         let residual = problem.prescribed_residual_n(&q);
         if residual.is_nan() || residual > COMPLETION_TOLERANCE * max_tension {
-            return Err(format!(
-                "the completed design leaves {residual:.3e} N out of balance (largest tension \
-                 {max_tension:.3e} N): the rear net does not mirror the front net"
-            ));
+            return Err(CompletionError::OutOfBalance {
+                residual_n: residual,
+                max_tension_n: max_tension,
+            });
         }
         let floor = problem.min_tension_fraction * (1.0 - 1e-9);
         if let Some(k) = (n..m).find(|&k| tensions[k].is_nan() || tensions[k] < floor) {
-            return Err(format!(
-                "cable {k} of the completion carries {:.3e} of the smallest set tension, below \
-                 the floor {}",
-                tensions[k], problem.min_tension_fraction
-            ));
+            return Err(CompletionError::BelowFloor {
+                cable: k,
+                tension: tensions[k],
+                floor: problem.min_tension_fraction,
+            });
         }
         Ok(q)
     }

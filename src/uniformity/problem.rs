@@ -61,48 +61,52 @@ impl UniformityProblem {
     ) -> Result<Self, UniformityError> {
         let structure = FdmStructure::new(&network)?;
         if sets.is_empty() {
-            return Err(UniformityError::Invalid("no uniformity set".into()));
+            return Err(UniformityError::invalid("uniformity sets", "none given"));
         }
         for set in &sets {
             if set.edges.is_empty() {
-                return Err(UniformityError::Invalid(format!(
-                    "uniformity set `{}` has no cable",
-                    set.name
-                )));
+                return Err(UniformityError::invalid(
+                    format!("uniformity set `{}`", set.name),
+                    "no cable",
+                ));
             }
             if let Some(&k) = set.edges.iter().find(|&&k| k >= network.n_edges()) {
-                return Err(UniformityError::Invalid(format!(
-                    "uniformity set `{}` names cable {k}, but the network has {}",
-                    set.name,
-                    network.n_edges()
-                )));
+                return Err(UniformityError::invalid(
+                    format!("uniformity set `{}`", set.name),
+                    format!(
+                        "names cable {k}, but the network has {} cables",
+                        network.n_edges()
+                    ),
+                ));
             }
             if !(set.mean_tension_n.is_finite() && set.mean_tension_n > 0.0) {
-                return Err(UniformityError::Invalid(format!(
-                    "uniformity set `{}`: mean tension {} must be > 0",
-                    set.name, set.mean_tension_n
-                )));
+                return Err(UniformityError::invalid(
+                    format!("uniformity set `{}`", set.name),
+                    format!("mean tension {} N must be > 0", set.mean_tension_n),
+                ));
             }
         }
         if max_force_density_n_per_m.is_nan() || max_force_density_n_per_m <= 0.0 {
-            return Err(UniformityError::Invalid(format!(
-                "maximum force density {max_force_density_n_per_m} must be > 0"
-            )));
+            return Err(UniformityError::invalid(
+                "maximum force density [q]",
+                format!("{max_force_density_n_per_m} N/m must be > 0"),
+            ));
         }
         let lengths_m: Vec<f64> = network.edges_vectors().into_iter().map(norm3).collect();
         if let Some(k) = lengths_m.iter().position(|&l| l.is_nan() || l <= 0.0) {
-            return Err(UniformityError::Invalid(format!(
-                "cable {k} (nodes {:?}) has zero length in the prescribed geometry",
-                network.edges[k]
-            )));
+            return Err(UniformityError::invalid(
+                format!("cable {k} (nodes {:?})", network.edges[k]),
+                "zero length in the prescribed geometry",
+            ));
         }
         if let Some(&i) = surface_nodes
             .iter()
             .find(|&&i| structure.free_index(i).is_none())
         {
-            return Err(UniformityError::Invalid(format!(
-                "surface node {i} is not free"
-            )));
+            return Err(UniformityError::invalid(
+                format!("surface node {i}"),
+                "not free",
+            ));
         }
         Ok(UniformityProblem {
             network,
@@ -153,19 +157,23 @@ impl UniformityProblem {
     /// cable (named).
     pub fn with_positions(&self, nodes_m: Vec<[f64; 3]>) -> Result<Self, UniformityError> {
         if nodes_m.len() != self.network.n_nodes() {
-            return Err(UniformityError::Invalid(format!(
-                "{} positions for {} nodes",
-                nodes_m.len(),
-                self.network.n_nodes()
-            )));
+            return Err(UniformityError::invalid(
+                "positions",
+                format!(
+                    "{} given for {} nodes",
+                    nodes_m.len(),
+                    self.network.n_nodes()
+                ),
+            ));
         }
         if let Some(i) = nodes_m
             .iter()
             .position(|p| !p.iter().all(|v| v.is_finite()))
         {
-            return Err(UniformityError::Invalid(format!(
-                "the position of node {i} is not finite"
-            )));
+            return Err(UniformityError::invalid(
+                format!("node {i}"),
+                "its position is not finite",
+            ));
         }
         let mut moved = self.clone();
         moved.network.nodes = nodes_m;
@@ -176,10 +184,10 @@ impl UniformityProblem {
             .map(norm3)
             .collect();
         if let Some(k) = moved.lengths_m.iter().position(|&l| l.is_nan() || l <= 0.0) {
-            return Err(UniformityError::Invalid(format!(
-                "cable {k} (nodes {:?}) has zero length in the prescribed geometry",
-                moved.network.edges[k]
-            )));
+            return Err(UniformityError::invalid(
+                format!("cable {k} (nodes {:?})", moved.network.edges[k]),
+                "zero length in the prescribed geometry",
+            ));
         }
         Ok(moved)
     }
@@ -192,16 +200,16 @@ impl UniformityProblem {
     pub fn with_loads(mut self, loads_n: Option<Vec<[f64; 3]>>) -> Result<Self, UniformityError> {
         if let Some(loads) = &loads_n {
             if loads.len() != self.network.n_nodes() {
-                return Err(UniformityError::Invalid(format!(
-                    "{} loads for {} nodes",
-                    loads.len(),
-                    self.network.n_nodes()
-                )));
+                return Err(UniformityError::invalid(
+                    "loads",
+                    format!("{} given for {} nodes", loads.len(), self.network.n_nodes()),
+                ));
             }
             if let Some(i) = loads.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
-                return Err(UniformityError::Invalid(format!(
-                    "the load on node {i} is not finite"
-                )));
+                return Err(UniformityError::invalid(
+                    format!("node {i}"),
+                    "its load is not finite",
+                ));
             }
         }
         self.network.loads = loads_n;

@@ -18,7 +18,7 @@
 
 use std::time::Instant;
 
-use super::conic::{infeasible, Class, Cone, ConicProgram};
+use super::conic::{infeasible_design, Class, Cone, ConicProgram};
 use super::{Design, Termination, UniformityError, UniformityProblem};
 
 /// Weight of the cables outside every set, relative to the set cables.
@@ -27,8 +27,12 @@ const OTHER_WEIGHT: f64 = 1e-6;
 /// The design closest to uniform tension with every set's ratio at most
 /// `ratio_bounds[s]` (one per set, each ≥ that set's optimal ratio).
 ///
+/// A bound below the optimum, or a geometry without strictly positive
+/// equilibria, is a design with [`Termination::Infeasible`] (the reason in its
+/// warnings, see [`Design::feasible`]).
+///
 /// # Errors
-/// A bound below the optimum (infeasible, nodes named) or a solver failure.
+/// A solver failure.
 ///
 /// # Panics
 /// If `ratio_bounds` does not have one entry per set.
@@ -89,7 +93,10 @@ pub fn most_uniform(
                 warnings,
             )
         }
-        Class::Infeasible => Err(infeasible(problem)),
+        Class::Infeasible => {
+            let warnings = outcome.warning(solver).into_iter().collect();
+            infeasible_design(problem, solver, outcome.iterations, start, warnings)
+        }
         Class::Failed => Err(UniformityError::SolverFailed {
             solver: "most-uniform selection",
             status: outcome.status,
