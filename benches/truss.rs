@@ -27,10 +27,9 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::Vector3;
 use ringmesh::fdm::solve_network;
+use ringmesh::frame::cantilever;
 use ringmesh::geometry::build_mesh;
-use ringmesh::mechanics::{
-    cantilever, ElementKind, NodalLoad, StaticSettings, StaticSolution, StaticSolver,
-};
+use ringmesh::mechanics::{ElementKind, NodalLoad, StaticSettings, StaticSolution, StaticSolver};
 use ringmesh::scene::Scene;
 use ringmesh::truss::RingTruss;
 

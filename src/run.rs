@@ -13,11 +13,11 @@ use crate::design::{
 };
 use crate::effects::CableSelfWeight;
 use crate::fdm::solve_network;
+use crate::frame::cantilever::{self, CantileverRow};
+use crate::frame::{FrameFile, FrameFileError, NodeOrigin};
 use crate::geometry::{build_mesh, ReflectorMesh};
-use crate::mechanics::cantilever::{self, CantileverRow};
 use crate::mechanics::{
-    rotation, ElementKind, FrameFile, FrameFileError, LimitSearch, NodeOrigin, StaticSolver,
-    StaticTermination, StepRecord,
+    rotation, ElementKind, LimitSearch, StaticSolver, StaticTermination, StepRecord,
 };
 use crate::network::{Network, NetworkSummary};
 use crate::report::{

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use nalgebra::Vector3;
-use ringmesh::mechanics::cantilever;
-use ringmesh::mechanics::{FrameFile, FrameFileError, StaticSolver, StaticTermination};
+use ringmesh::frame::{cantilever, FrameFile, FrameFileError};
+use ringmesh::mechanics::{StaticSolver, StaticTermination};
 use serde_json::Value;
 
 fn problem(name: &str) -> PathBuf {

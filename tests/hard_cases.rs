@@ -13,11 +13,12 @@ use std::time::Instant;
 use nalgebra::{UnitQuaternion, Vector3};
 use ringmesh::design::TiedNets;
 use ringmesh::fdm::solve_network;
+use ringmesh::frame::{cantilever, FrameFile};
 use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::rotation::exp;
 use ringmesh::mechanics::{
-    cantilever, ElementKind, FrameFile, MechanicsError, ModelBuilder, NodalLoad, PathControl,
-    StaticSettings, StaticSolver, StaticTermination,
+    ElementKind, MechanicsError, ModelBuilder, NodalLoad, PathControl, StaticSettings,
+    StaticSolver, StaticTermination,
 };
 use ringmesh::network::{Network, NetworkError};
 use ringmesh::run::scene_problem;

@@ -358,8 +358,21 @@ mod tests {
     use nalgebra::Vector3;
 
     use super::*;
-    use crate::mechanics::cantilever::{section, LENGTH_M};
-    use crate::mechanics::{ElementKind, ModelBuilder, RodSpec};
+    use crate::mechanics::{ElementKind, ModelBuilder, RodSpec, Section};
+
+    /// Length of the column, m.
+    const LENGTH_M: f64 = 10.0;
+
+    /// The column's section: EA = GA = 10⁴ N, GJ = EI = 100 N·m² (the
+    /// cantilever benchmark's).
+    fn section() -> Section {
+        Section {
+            axial_n: 1e4,
+            shear_n: [1e4, 1e4],
+            torsion_nm2: 100.0,
+            bending_nm2: [100.0, 100.0],
+        }
+    }
 
     /// A column clamped at its foot, free at its head, under an axial
     /// compression `p_n` at the head (Euler's case 1). Its section has equal
