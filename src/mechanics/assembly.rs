@@ -20,9 +20,9 @@ use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatMut};
 use rayon::prelude::*;
 
-use super::beam::Frame;
 use super::joint::ConstraintRow;
 use super::model::{MechanicsError, Model};
+use super::node::Frame;
 
 /// Index of a fixed component.
 const FIXED: usize = usize::MAX;

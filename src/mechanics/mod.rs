@@ -15,16 +15,18 @@ pub mod beam;
 pub mod cable;
 pub mod joint;
 pub mod model;
+mod node;
 pub mod rotation;
 pub mod stability;
 pub mod statics;
 
 pub(crate) use assembly::constraint_scale;
 pub use assembly::State;
-pub use beam::{ElementKind, Frame, Section};
+pub use beam::{ElementKind, Section};
 pub use cable::{Cable, CableState};
 pub use joint::JointKind;
-pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, Rod, RodSpec};
+pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, Rod, RodSpec};
+pub use node::{Frame, NodeId};
 pub use stability::{limit_load_factor, LimitSearch, Stability};
 pub use statics::{
     PathControl, StaticSettings, StaticSolution, StaticSolver, StaticTermination, StepRecord,
