@@ -14,9 +14,13 @@ mod assembly;
 pub mod beam;
 pub mod cable;
 pub mod joint;
+mod limit;
+mod load_control;
 pub mod model;
 mod node;
 pub mod rotation;
+mod settings;
+mod solver;
 pub mod stability;
 pub mod statics;
 
@@ -25,9 +29,9 @@ pub use assembly::State;
 pub use beam::{ElementKind, Section};
 pub use cable::{Cable, CableState};
 pub use joint::JointKind;
+pub use limit::{limit_load_factor, LimitSearch};
 pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, Rod, RodSpec};
 pub use node::{Frame, NodeId};
-pub use stability::{limit_load_factor, LimitSearch, Stability};
-pub use statics::{
-    PathControl, StaticSettings, StaticSolution, StaticSolver, StaticTermination, StepRecord,
-};
+pub use settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
+pub use solver::StaticSolver;
+pub use stability::Stability;
