@@ -57,7 +57,9 @@ pub(super) fn stability(
     let ev = system.evaluate(solver.model(), state, lambda);
     let lu = system
         .factor(&ev.values)
-        .map_err(|detail| MechanicsError::Mechanism { detail })?;
+        .map_err(|e| MechanicsError::Mechanism {
+            detail: e.to_string(),
+        })?;
     let w = solver.weights();
     let n_free = system.n_free;
     // A start with every component: a fixed pseudo-random sequence.

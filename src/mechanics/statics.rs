@@ -61,7 +61,9 @@ impl StaticSolver {
         let lu = self
             .system()
             .factor(&ev.values)
-            .map_err(|detail| MechanicsError::Mechanism { detail })?;
+            .map_err(|e| MechanicsError::Mechanism {
+                detail: e.to_string(),
+            })?;
         let mut rhs = self.system().column(&ev.residual);
         System::solve_in_place(&lu, rhs.as_mut());
         let delta: Vec<f64> = (0..self.system().n_rows).map(|i| -rhs[(i, 0)]).collect();
