@@ -15,13 +15,13 @@ pub enum FrameFileError {
         source: std::io::Error,
     },
     /// Not TOML of the frame format (unknown or missing key, wrong type); the
-    /// parser's message names the key and the line.
-    #[error("{path}: {message}")]
+    /// parser's error names the key and the line.
+    #[error("{path}: {source}")]
     Parse {
         /// The file.
         path: String,
-        /// The parser's message.
-        message: String,
+        /// The parser's error.
+        source: toml::de::Error,
     },
     /// A value is invalid.
     #[error("{key}: {reason}")]

@@ -21,9 +21,9 @@ impl FrameFile {
             source,
         })?;
         FrameFile::from_toml(&text).map_err(|e| match e {
-            FrameFileError::Parse { message, .. } => FrameFileError::Parse {
+            FrameFileError::Parse { source, .. } => FrameFileError::Parse {
                 path: shown,
-                message,
+                source,
             },
             other => other,
         })
@@ -34,9 +34,9 @@ impl FrameFile {
     /// # Errors
     /// As [`FrameFile::read`].
     pub fn from_toml(text: &str) -> Result<FrameFile, FrameFileError> {
-        let raw: RawFile = toml::from_str(text).map_err(|e| FrameFileError::Parse {
+        let raw: RawFile = toml::from_str(text).map_err(|source| FrameFileError::Parse {
             path: "<frame>".into(),
-            message: e.to_string(),
+            source,
         })?;
         build(raw)
     }
