@@ -23,6 +23,7 @@ use rayon::prelude::*;
 use super::joint::ConstraintRow;
 use super::model::{MechanicsError, Model};
 use super::node::Frame;
+use crate::algebra::norm_inf;
 
 /// Index of a fixed component.
 const FIXED: usize = usize::MAX;
@@ -380,7 +381,7 @@ impl System {
             for (p, v) in self.pattern.iter().zip(values) {
                 dense[(p.row, p.col)] += v;
             }
-            let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let largest = norm_inf(values);
             let lu = dense.partial_piv_lu();
             let roundoff = self.n_rows as f64 * f64::EPSILON * largest;
             let u = lu.U();

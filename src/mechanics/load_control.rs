@@ -14,6 +14,7 @@ use std::time::Instant;
 use super::assembly::{State, System};
 use super::settings::{StaticSettings, StaticSolution, StaticTermination, StepRecord};
 use super::solver::{wdot, StaticSolver};
+use crate::algebra::norm2;
 
 /// Largest ratio of a Newton correction to the increment before it (weighted
 /// norm) for a load step to count as converging on its branch: with every
@@ -155,7 +156,7 @@ fn newton(
             .enumerate()
             .map(|(i, (d, r))| if i < n_free { -d * r } else { d * r })
             .sum();
-        if curvature < -CURVATURE_NOISE * norm(&delta) * norm(&ev.residual) {
+        if curvature < -CURVATURE_NOISE * norm2(&delta) * norm2(&ev.residual) {
             run.negative_curvature = true;
         }
         let size = wdot(w, &delta, &delta).sqrt();
@@ -318,9 +319,4 @@ pub(super) fn follow(
         reactions,
         time_s: clock.elapsed().as_secs_f64(),
     }
-}
-
-/// Euclidean norm.
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }

@@ -8,6 +8,7 @@
 use super::assembly::{Evaluation, State, System};
 use super::model::{MechanicsError, Model};
 use super::settings::StaticSettings;
+use crate::algebra::norm_inf;
 
 /// A static solver for one model: the structure is analysed once, then any
 /// number of solves (new loads through [`StaticSolver::model_mut`]).
@@ -86,16 +87,12 @@ impl StaticSolver {
         settings: &StaticSettings,
     ) -> (f64, bool) {
         let n = self.system.n_free;
-        let force = ev.residual[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let gap = ev.residual[n..].iter().fold(0.0f64, |m, v| m.max(v.abs())) / self.system.scale;
+        let force = norm_inf(&ev.residual[..n]);
+        let gap = norm_inf(&ev.residual[n..]) / self.system.scale;
         if !(force.is_finite() && gap.is_finite()) {
             return (f64::NAN, false);
         }
-        let reaction_scale = ev
-            .reactions
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let reaction_scale = norm_inf(ev.reactions.as_flattened());
         let roundoff =
             64.0 * f64::EPSILON * (ev.internal_scale + self.system.scale * self.coordinate_scale);
         let force_scale = (self.load_scale() * lambda.abs())
