@@ -76,7 +76,7 @@ const MAX_GROWTH: f64 = 4.0;
 /// The path from the unstressed frame is followed in steps sized by the
 /// lowest stiffness `μ(λ)` of the stable states found so far: each step goes
 /// at most half-way to where the line through the last two `(λ, μ)` crosses
-/// zero (and at most ×[`MAX_GROWTH`]), so that an eigenvalue turns negative
+/// zero (and at most ×4, `MAX_GROWTH`), so that an eigenvalue turns negative
 /// within a short step, while it is still the least in magnitude and inverse
 /// iteration finds it. The first unstable state (or a load with no
 /// equilibrium) brackets the limit, and bisection narrows the bracket. Each

@@ -349,7 +349,7 @@ impl ModelBuilder {
     /// A tension-only cable between the positions of nodes `a` and `b` with
     /// axial stiffness `axial_n` (EA, N) and unstressed length ramped from
     /// `rest_lengths_m[0]` at load factor 0 to `rest_lengths_m[1]` at 1
-    /// (see [`super::cable`]). Returns its index.
+    /// (see [`Cable`]). Returns its index.
     pub fn add_cable(
         &mut self,
         a: NodeId,
