@@ -8,7 +8,9 @@
 //! found on the state instead ([`crate::mechanics::Stability`]): the pull is
 //! multiplied by 1, 2, 4 until the equilibrium is unstable, then bisected.
 
-use super::{check_loads, exact::nodal_loads, RingTruss, TrussError};
+use super::builder::RingTruss;
+use super::exact::nodal_loads;
+use super::response::{check_loads, TrussError};
 use crate::mechanics::{limit_load_factor, LimitSearch, StaticSettings, StaticSolver};
 
 /// How far the margin is searched: a truss stable at this multiple of the

@@ -1,4 +1,5 @@
-//! The `truss` command's work: a scene's truss model under the pull of its net
+//! A scene's truss: the model its `[effects] truss` asks for ([`oracle`]),
+//! and the `truss` command's work — that model under the pull of its net
 //! (forward FDM with the net's initial q) or under loads read from a file,
 //! reported per attachment point.
 
@@ -6,9 +7,13 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{oracle, TrussError};
+use super::builder::RingTruss;
+use super::exact::ExactTruss;
+use super::linear::LinearTruss;
+use super::response::{TrussError, TrussOracle};
+use super::rigid::RigidTruss;
 use crate::fdm::solve_network;
-use crate::geometry::build_mesh;
+use crate::geometry::{build_mesh, RingTrussLayout};
 use crate::scene::{Scene, TrussModel};
 
 /// Attachment loads in a file: `{"loads_n": [[fx, fy, fz], …]}`, top hinges
@@ -125,5 +130,22 @@ pub fn respond(
         newton_iterations: response.newton_iterations,
         load_steps: response.load_steps,
         time_s: response.time_s,
+    })
+}
+
+/// The oracle a scene asks for (`[effects] truss`): only that model is built —
+/// a rigid scene never constructs a beam model.
+///
+/// # Errors
+/// A frame that cannot be built.
+pub fn oracle(
+    model: TrussModel,
+    scene: &Scene,
+    layout: &RingTrussLayout,
+) -> Result<Box<dyn TrussOracle>, TrussError> {
+    Ok(match model {
+        TrussModel::Rigid => Box::new(RigidTruss::new(layout)),
+        TrussModel::Linear => Box::new(LinearTruss::new(RingTruss::new(scene, layout)?, layout)?),
+        TrussModel::Exact => Box::new(ExactTruss::new(RingTruss::new(scene, layout)?, layout)?),
     })
 }
