@@ -28,10 +28,9 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::Vector3;
 use ringmesh::effects::SceneEffects;
 use ringmesh::fdm::solve_network;
+use ringmesh::frame::cantilever;
 use ringmesh::geometry::build_mesh;
-use ringmesh::mechanics::{
-    cantilever, ElementKind, NodalLoad, StaticSettings, StaticSolution, StaticSolver,
-};
+use ringmesh::mechanics::{ElementKind, NodalLoad, StaticSettings, StaticSolution, StaticSolver};
 use ringmesh::scene::Scene;
 use ringmesh::truss::RingTruss;
 

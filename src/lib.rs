@@ -21,6 +21,8 @@
 //!   pluggable solvers (bisection, LP, gradient, least squares);
 //! * [`mechanics`] — the multibody statics engine: geometrically exact beams,
 //!   rigid bodies, joints, cables, Newton with load steps or arc length;
+//! * [`frame`] — the engine's inputs: the frame file (TOML) and the paper's
+//!   cantilever benchmark;
 //! * [`truss`] — the ring truss and its response oracles (rigid, linear, exact);
 //! * [`design`] — the outer loop: net design and truss response to a fixed point;
 //! * [`verify`] — the design cut to length and assembled on the flexible truss;
@@ -34,6 +36,7 @@ pub mod algebra;
 pub mod design;
 pub mod effects;
 pub mod fdm;
+pub mod frame;
 pub mod geometry;
 pub mod mechanics;
 pub mod network;
@@ -73,7 +76,7 @@ pub enum Error {
     Truss(#[from] truss::TrussError),
     /// An invalid frame file, or a frame that cannot be built.
     #[error(transparent)]
-    Frame(#[from] mechanics::FrameFileError),
+    Frame(#[from] frame::FrameFileError),
     /// The outer design loop failed.
     #[error(transparent)]
     Design(#[from] design::DesignError),

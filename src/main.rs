@@ -240,7 +240,7 @@ enum Command {
     /// Writes every node's position, displacement and rotation vector, the
     /// support reactions and the solver's statistics (termination, load steps,
     /// Newton iterations, residual history, time) as JSON; prints a summary.
-    /// The file format is documented in src/mechanics/frame_file.rs.
+    /// The file format is documented in src/frame/mod.rs.
     ///
     /// Example: ringmesh frame problems/frames/cantilever-moment.toml
     Frame {

@@ -6,8 +6,8 @@
 mod common;
 
 use nalgebra::Vector3;
-use ringmesh::mechanics::cantilever;
-use ringmesh::mechanics::{FrameFile, FrameFileError, StaticSolver, StaticTermination};
+use ringmesh::frame::{cantilever, FrameFile, FrameFileError};
+use ringmesh::mechanics::{StaticSolver, StaticTermination};
 use serde_json::Value;
 
 #[test]

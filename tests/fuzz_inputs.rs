@@ -12,8 +12,9 @@ use std::path::Path;
 
 use proptest::prelude::*;
 use ringmesh::fdm::solve_network;
+use ringmesh::frame::FrameFile;
 use ringmesh::geometry::build_mesh;
-use ringmesh::mechanics::{FrameFile, StaticSolver};
+use ringmesh::mechanics::StaticSolver;
 use ringmesh::scene::Scene;
 use toml::{Table, Value};
 

@@ -15,11 +15,12 @@ use ringmesh::design::scene_problem;
 use ringmesh::design::TiedNets;
 use ringmesh::effects::SceneEffects;
 use ringmesh::fdm::solve_network;
+use ringmesh::frame::{cantilever, FrameFile};
 use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::rotation::exp;
 use ringmesh::mechanics::{
-    cantilever, ElementKind, FrameFile, MechanicsError, ModelBuilder, NodalLoad, PathControl,
-    StaticSettings, StaticSolver, StaticTermination,
+    ElementKind, MechanicsError, ModelBuilder, NodalLoad, PathControl, StaticSettings,
+    StaticSolver, StaticTermination,
 };
 use ringmesh::network::{Network, NetworkError};
 use ringmesh::scene::TrussModel;

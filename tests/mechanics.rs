@@ -8,10 +8,11 @@
 use std::f64::consts::{PI, TAU};
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use ringmesh::frame::cantilever;
 use ringmesh::mechanics::rotation::{exp, log, skew, tangent};
 use ringmesh::mechanics::{
-    cantilever, ElementKind, Frame, JointKind, MechanicsError, ModelBuilder, NodeId, PathControl,
-    Rod, RodSpec, Section, StaticSettings, StaticSolution, StaticSolver, StaticTermination,
+    ElementKind, Frame, JointKind, MechanicsError, ModelBuilder, NodeId, PathControl, Rod, RodSpec,
+    Section, StaticSettings, StaticSolution, StaticSolver, StaticTermination,
 };
 
 mod common;

@@ -11,7 +11,9 @@ use std::time::Instant;
 use faer::Mat;
 
 use super::assembly::{State, System};
-use super::statics::{StaticSettings, StaticSolution, StaticSolver, StaticTermination, StepRecord};
+use super::load_control;
+use super::settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
+use super::solver::{wdot, StaticSolver};
 
 /// Iterations a step aims for; the arc length adapts as `√(target / used)`.
 const TARGET_ITERATIONS: f64 = 5.0;
@@ -32,43 +34,18 @@ fn reference_load(solver: &StaticSolver, system: &System) -> Vec<f64> {
     f
 }
 
-/// Weights of the arc-length norm: 1 on translations, `ℓ` on rotations, 0 on multipliers.
-pub(crate) fn weights(solver: &StaticSolver, system: &System) -> Vec<f64> {
-    let model = solver.model();
-    let mean_length = if model.elements.is_empty() {
-        solver.length_scale()
-    } else {
-        model.elements.iter().map(|e| e.length_m).sum::<f64>() / model.elements.len() as f64
-    };
-    let mut w = vec![0.0; system.n_rows];
-    for n in 0..model.node_count() {
-        for c in 0..6 {
-            if let Some(i) = system.unknown(n, c) {
-                w[i] = if c < 3 { 1.0 } else { mean_length };
-            }
-        }
-    }
-    w
-}
-
-pub(crate) fn wdot(w: &[f64], a: &[f64], b: &[f64]) -> f64 {
-    w.iter()
-        .zip(a)
-        .zip(b)
-        .map(|((w, a), b)| w * w * a * b)
-        .sum()
-}
-
-pub(crate) fn follow(
+/// Follows the path from `start`, an equilibrium at load factor `lambda0`,
+/// to λ = 1, or to a limit point.
+pub(super) fn follow(
     solver: &StaticSolver,
-    system: &System,
     start: State,
     lambda0: f64,
     settings: &StaticSettings,
 ) -> StaticSolution {
     let clock = Instant::now();
+    let system = solver.system();
     let f_hat = reference_load(solver, system);
-    let w = weights(solver, system);
+    let w = solver.weights();
     let n = system.n_rows;
 
     let mut state = start;
@@ -200,14 +177,15 @@ pub(crate) fn follow(
                 initial_step: 1.0,
                 ..settings.clone()
             };
-            let landed = solver.solve_from(
-                landing.clone(),
-                lambda,
-                &StaticSettings {
-                    path: super::statics::PathControl::Load,
-                    ..run_settings
-                },
-            );
+            let landing_settings = StaticSettings {
+                path: PathControl::Load,
+                ..run_settings
+            };
+            // What `solver.solve_from` does for load control (it dispatches to
+            // this file, which therefore calls load control itself).
+            let landed = landing_settings
+                .validate()
+                .map(|()| load_control::follow(solver, landing.clone(), lambda, &landing_settings));
             if let Ok(sol) = landed {
                 newton_iterations += sol.newton_iterations;
                 if sol.converged() {

@@ -20,9 +20,10 @@ use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatMut};
 use rayon::prelude::*;
 
-use super::beam::Frame;
 use super::joint::ConstraintRow;
 use super::model::{MechanicsError, Model};
+use super::node::Frame;
+use crate::algebra::norm_inf;
 
 /// Index of a fixed component.
 const FIXED: usize = usize::MAX;
@@ -40,6 +41,28 @@ const DENSE_ROWS: usize = 64;
 pub(crate) enum Factor {
     Dense(PartialPivLu<f64>),
     Sparse(Lu<usize, f64>),
+}
+
+/// Why the tangent could not be factored.
+#[derive(Debug, Clone, Copy, thiserror::Error)]
+pub(crate) enum FactorError {
+    /// A pivot of the dense LU at or below the roundoff of a zero pivot,
+    /// `n ε ‖J‖max`, or not a number: a mechanism.
+    #[error("singular tangent: pivot {pivot} is {value:e}, below the roundoff {roundoff:e}")]
+    SingularPivot {
+        /// The pivot's index.
+        pivot: usize,
+        /// Its value.
+        value: f64,
+        /// The roundoff of a zero pivot.
+        roundoff: f64,
+    },
+    /// faer could not build the sparse matrix from the pattern's values.
+    #[error("{0:?}")]
+    SparseMatrix(faer::sparse::FaerError),
+    /// faer's sparse LU failed (a structurally singular matrix, or memory).
+    #[error("{0:?}")]
+    SparseLu(faer::sparse::linalg::LuError),
 }
 
 /// The assembled problem's structure: dof numbering, pattern, symbolic LU.
@@ -352,13 +375,13 @@ impl System {
     /// # Errors
     /// A singular tangent: for the dense factor, a pivot below `n ε ‖J‖max`,
     /// the roundoff of a zero pivot (a mechanism).
-    pub fn factor(&self, values: &[f64]) -> Result<Factor, String> {
+    pub fn factor(&self, values: &[f64]) -> Result<Factor, FactorError> {
         if self.n_rows <= DENSE_ROWS {
             let mut dense = Mat::<f64>::zeros(self.n_rows, self.n_rows);
             for (p, v) in self.pattern.iter().zip(values) {
                 dense[(p.row, p.col)] += v;
             }
-            let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let largest = norm_inf(values);
             let lu = dense.partial_piv_lu();
             let roundoff = self.n_rows as f64 * f64::EPSILON * largest;
             let u = lu.U();
@@ -367,18 +390,19 @@ impl System {
                 pivot.is_nan() || pivot <= roundoff
             };
             if let Some(i) = (0..self.n_rows).find(singular) {
-                return Err(format!(
-                    "singular tangent: pivot {i} is {:e}, below the roundoff {roundoff:e}",
-                    u[(i, i)]
-                ));
+                return Err(FactorError::SingularPivot {
+                    pivot: i,
+                    value: u[(i, i)],
+                    roundoff,
+                });
             }
             return Ok(Factor::Dense(lu));
         }
         let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(FactorError::SparseMatrix)?;
         Lu::try_new_with_symbolic(self.lu.clone(), matrix.as_ref())
             .map(Factor::Sparse)
-            .map_err(|e| format!("{e:?}"))
+            .map_err(FactorError::SparseLu)
     }
 
     /// Solve `J Δ = rhs` in place with a factor of the tangent.

@@ -37,10 +37,11 @@
 //! two the principal axes of the section; `C_N = diag(EA, GA₂, GA₃)`,
 //! `C_M = diag(GJ, EI₂, EI₃)` (paper eq. 21).
 
-use nalgebra::{Const, Matrix3, SMatrix, SVector, UnitQuaternion, Vector3, U1};
+use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, U1};
 use num_dual::{hessian, Dual2SVec64, DualNum};
 use serde::{Deserialize, Serialize};
 
+use super::node::Frame;
 use super::rotation::{
     exp_generic, exp_second_order, left_jacobian_inverse_generic, lift_m, lift_v, log_generic,
     mat_vec, scale, skew, M3, V3,
@@ -143,15 +144,6 @@ pub(crate) struct BeamElement {
     stiffness: [f64; 6],
     /// Strains of the reference configuration (`Γ₀`, `K₀`, or `d₀/L`).
     reference_strain: [f64; 6],
-}
-
-/// A node's configuration: position and rotation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Frame {
-    /// Position, m.
-    pub position_m: Vector3<f64>,
-    /// Rotation from the material to the spatial frame.
-    pub rotation: UnitQuaternion<f64>,
 }
 
 /// The element's relative frame, all its energy depends on:

@@ -12,7 +12,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::model::NodeId;
+use super::node::NodeId;
 
 /// Axial stiffness of a slack cable, as a fraction of its EA.
 pub const SLACK_STIFFNESS_RATIO: f64 = 1e-9;

@@ -15,8 +15,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::beam::Frame;
-use super::rotation::skew;
+use super::node::Frame;
+use super::rotation::{rod_frame, skew};
 
 /// The kinds of joint.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,7 +75,7 @@ impl Joint {
             }
             JointKind::Revolute { axis } => {
                 let h = axis.normalize();
-                let u = super::model::rod_frame(&h, &Vector3::z()) * Vector3::y();
+                let u = rod_frame(&h, &Vector3::z()) * Vector3::y();
                 let v = h.cross(&u);
                 vec![[local(h)[0], local(u)[1]], [local(h)[0], local(v)[1]]]
             }

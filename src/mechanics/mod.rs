@@ -1,34 +1,51 @@
 //! A multibody statics engine for frames of geometrically exact rods, rigid
 //! bodies and joints (paper §3, DESIGN §5): the ring truss is one such frame.
+//! The engine knows nothing of files: [`crate::frame`] reads frame files into
+//! its [`Model`].
 //!
-//! * [`rotation`] — SO(3): exponential, logarithm, tangent operator (eq. 7–14);
-//! * [`beam`] — the 2-node beam elements: Crisfield–Jelenić (eq. 17–21) and SE(3);
-//! * [`joint`] — fixed, revolute and spherical joints as constraints (eq. 22–25);
-//! * [`model`] — nodes, rods, bodies, joints, supports, loads: a validated frame;
-//! * [`stability`] — stability of an equilibrium and the limit load;
-//! * [`statics`] — Newton–Raphson with adaptive load stepping, and
-//!   arc-length continuation (`arc_length`) through limit points.
+//! Its files, each using only those above it in this list:
+//!
+//! * [`rotation`] — SO(3): exponential, logarithm, tangent operator (eq. 7–14),
+//!   and the material frame of a rod; `node` — a node's id and configuration;
+//! * `beam` — the 2-node beam elements: Crisfield–Jelenić (eq. 17–21) and
+//!   SE(3); `cable` — tension-only cables; `joint` — fixed, revolute and
+//!   spherical joints as constraints (eq. 22–25);
+//! * `model` — nodes, rods, bodies, joints, supports, loads: a validated frame;
+//! * `assembly` — the residual and the consistent tangent, factored;
+//! * `settings` — what a solve takes and returns; `solver` — the solver's
+//!   core: convergence test, weighted norm of increments;
+//! * `load_control` — Newton–Raphson with adaptive load stepping;
+//!   `arc_length` — arc-length continuation through limit points;
+//!   `stability` — the stability of one equilibrium;
+//! * `statics` — the solver's entry points ([`StaticSolver::solve`], …);
+//! * `limit` — the limit load ([`limit_load_factor`]).
+//!
+//! Only [`rotation`], a namespace of functions (`rotation::exp`, …), is a
+//! public module; everything else is re-exported here.
 
 mod arc_length;
 mod assembly;
-pub mod beam;
-pub mod cable;
-pub mod cantilever;
-pub mod frame_file;
-pub mod joint;
-pub mod model;
+mod beam;
+mod cable;
+mod joint;
+mod limit;
+mod load_control;
+mod model;
+mod node;
 pub mod rotation;
-pub mod stability;
-pub mod statics;
+mod settings;
+mod solver;
+mod stability;
+mod statics;
 
 pub(crate) use assembly::constraint_scale;
 pub use assembly::State;
-pub use beam::{ElementKind, Frame, Section};
+pub use beam::{ElementKind, Section};
 pub use cable::{Cable, CableState};
-pub use frame_file::{FrameFile, FrameFileError, NodeOrigin};
 pub use joint::JointKind;
-pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, NodeId, Rod, RodSpec};
-pub use stability::{limit_load_factor, LimitSearch, Stability};
-pub use statics::{
-    PathControl, StaticSettings, StaticSolution, StaticSolver, StaticTermination, StepRecord,
-};
+pub use limit::{limit_load_factor, LimitSearch};
+pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, Rod, RodSpec};
+pub use node::{Frame, NodeId};
+pub use settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
+pub use solver::StaticSolver;
+pub use stability::Stability;

@@ -5,14 +5,13 @@
 //! A rigid body (paper §3.3) is a 6-DOF node with no element of its own: its
 //! marker points (eq. 22) are the offsets at which joints and loads act.
 
-use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector3};
 
-use super::beam::{BeamElement, ElementKind, Frame, Section};
+use super::beam::{BeamElement, ElementKind, Section};
 use super::cable::Cable;
 use super::joint::{Joint, JointKind};
-
-/// Index of a node in a [`Model`].
-pub type NodeId = usize;
+use super::node::{Frame, NodeId};
+use super::rotation::rod_frame;
 
 /// A model that cannot be built; every variant names the item at fault.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -350,7 +349,7 @@ impl ModelBuilder {
     /// A tension-only cable between the positions of nodes `a` and `b` with
     /// axial stiffness `axial_n` (EA, N) and unstressed length ramped from
     /// `rest_lengths_m[0]` at load factor 0 to `rest_lengths_m[1]` at 1
-    /// (see [`super::cable`]). Returns its index.
+    /// (see [`Cable`]). Returns its index.
     pub fn add_cable(
         &mut self,
         a: NodeId,
@@ -464,22 +463,4 @@ impl ModelBuilder {
             rods: self.rods,
         })
     }
-}
-
-/// The material frame of a rod: first axis along `axis`, second as close to
-/// `up` as possible (or to a global axis, when `up` is along the rod).
-pub fn rod_frame(axis: &Vector3<f64>, up: &Vector3<f64>) -> UnitQuaternion<f64> {
-    let e1 = axis.normalize();
-    let mut helper = *up - e1 * e1.dot(up);
-    if helper.norm() < 1e-8 * up.norm().max(1.0) {
-        // Any axis the rod is least aligned with.
-        let k = e1.iamin();
-        let mut g = Vector3::zeros();
-        g[k] = 1.0;
-        helper = g - e1 * e1.dot(&g);
-    }
-    let e2 = helper.normalize();
-    let e3 = e1.cross(&e2);
-    let m = Matrix3::from_columns(&[e1, e2, e3]);
-    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m))
 }

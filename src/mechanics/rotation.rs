@@ -1,5 +1,7 @@
-//! Rotations: SO(3) exponential and logarithm, the tangent operator, and the
-//! generic-scalar kernels the beam elements differentiate (paper eq. 7–14).
+//! Rotations: SO(3) exponential and logarithm, the tangent operator, the
+//! generic-scalar kernels the beam elements differentiate (paper eq. 7–14),
+//! and the material frame of a straight rod ([`rod_frame`]), which the model
+//! meshes rods with and revolute joints take their directors from.
 //!
 //! Conventions. A rotation vector `θ` (axis × angle) maps to `R = exp(θ̃)`
 //! (Rodrigues, paper eq. 7); `θ̃` is the skew matrix with `θ̃ v = θ × v`.
@@ -14,7 +16,7 @@
 //! exactly; near zero angle they switch to Taylor series in `θ²`, which stay
 //! differentiable where `|θ|` is not.
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use num_dual::DualNum;
 
 /// The skew matrix `ṽ` of a vector: `ṽ w = v × w`.
@@ -105,6 +107,24 @@ pub(crate) fn lift_m(m: &Matrix3<f64>) -> M3<f64> {
 
 pub(crate) fn dot<S: DualNum<f64> + Copy>(a: &V3<S>, b: &V3<S>) -> S {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The material frame of a rod: first axis along `axis`, second as close to
+/// `up` as possible (or to a global axis, when `up` is along the rod).
+pub fn rod_frame(axis: &Vector3<f64>, up: &Vector3<f64>) -> UnitQuaternion<f64> {
+    let e1 = axis.normalize();
+    let mut helper = *up - e1 * e1.dot(up);
+    if helper.norm() < 1e-8 * up.norm().max(1.0) {
+        // Any axis the rod is least aligned with.
+        let k = e1.iamin();
+        let mut g = Vector3::zeros();
+        g[k] = 1.0;
+        helper = g - e1 * e1.dot(&g);
+    }
+    let e2 = helper.normalize();
+    let e3 = e1.cross(&e2);
+    let m = Matrix3::from_columns(&[e1, e2, e3]);
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m))
 }
 
 #[cfg(test)]

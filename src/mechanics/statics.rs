@@ -1,457 +1,21 @@
-//! Static equilibrium: Newton–Raphson with adaptive load stepping, and an
-//! arc-length (Crisfield) path for limit points (paper §3.5 solves dynamics;
-//! we solve statics, DESIGN §5).
-//!
-//! Load stepping: the dead loads are scaled by a load factor `λ` ramped to 1.
-//! A step that does not converge is undone and cut (÷4); a step that converges
-//! in few iterations lets the next one grow (×2). Newton must converge from
-//! the step's tangent prediction without moving away from it; a step that
-//! does not — past a limit point Newton bounces through unstable states to a
-//! snapped-through branch — is undone and cut too, so a structure loaded
-//! beyond its limit load ends at the limit ([`StaticTermination::LimitPoint`])
-//! instead of on a snapped-through equilibrium. Failing to converge is a
-//! [`StaticTermination`] in the solution, never a silently wrong state.
+//! Static equilibrium, the solver's entry points: [`StaticSolver::solve`]
+//! and [`StaticSolver::solve_from`] follow the dead loads by load control
+//! (`load_control`: Newton–Raphson with adaptive load stepping) or by arc
+//! length (`arc_length`, through limit points) — paper §3.5 solves dynamics;
+//! we solve statics, DESIGN §5. Also the small-displacement response and the
+//! stability of a state (`stability`). Failing to converge is a
+//! [`StaticTermination`](super::StaticTermination) in the solution, never a
+//! silently wrong state.
 
-use std::time::Instant;
-
-use serde::Serialize;
-
-use super::arc_length::{wdot, weights};
-use super::assembly::{Evaluation, State, System};
-use super::model::{MechanicsError, Model};
-
-/// How a static solve ended.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(tag = "status", rename_all = "snake_case")]
-pub enum StaticTermination {
-    /// Equilibrium at the full load (λ = 1).
-    Converged,
-    /// The load step fell below the minimum before λ = 1, Newton failing to
-    /// converge without a sign of instability: the last converged load factor
-    /// is in the solution.
-    Stalled {
-        /// Last converged load factor.
-        load_factor: f64,
-    },
-    /// The structure cannot carry the full load on the branch it started on:
-    /// its limit load is about `limit_load_factor` × the applied loads.
-    ///
-    /// Arc length: the path passed a maximum of the load factor below 1, and
-    /// `limit_load_factor` is the largest on the path. Load control: the step
-    /// was cut below the minimum because every try beyond `limit_load_factor`
-    /// left the branch — Newton moved away from the tangent's prediction
-    /// (towards a snapped-through branch), the path's slope jumped tenfold, or
-    /// Newton failed through unstable states; the limit lies within a few
-    /// minimum steps above it.
-    LimitPoint {
-        /// The largest load factor reached on the branch.
-        limit_load_factor: f64,
-    },
-    /// The step budget ran out.
-    MaxSteps {
-        /// Last converged load factor.
-        load_factor: f64,
-    },
-}
-
-impl std::fmt::Display for StaticTermination {
-    /// One clause a person can read: `passed a limit point at load factor
-    /// 0.6555 (the structure carries about 0.6555 × the applied loads)`.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            StaticTermination::Converged => f.write_str("converged at the full load"),
-            StaticTermination::Stalled { load_factor } => write!(
-                f,
-                "stalled: Newton stopped converging at load factor {load_factor:.4}, with no \
-                 sign of instability"
-            ),
-            StaticTermination::LimitPoint { limit_load_factor } => write!(
-                f,
-                "passed a limit point at load factor {limit_load_factor:.4} (the structure \
-                 carries about {limit_load_factor:.4} × the applied loads)"
-            ),
-            StaticTermination::MaxSteps { load_factor } => {
-                write!(f, "ran out of load steps at load factor {load_factor:.4}")
-            }
-        }
-    }
-}
-
-/// How the load is followed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PathControl {
-    /// Load control: λ ramped to 1 with adaptive steps.
-    #[default]
-    Load,
-    /// Arc-length control (cylindrical, Crisfield): follows the path through
-    /// limit points.
-    ArcLength,
-}
-
-/// Settings of the static solver: plain data with defaults.
-#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct StaticSettings {
-    /// Relative force tolerance: `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞,
-    /// largest cable force)`.
-    pub tolerance: f64,
-    /// Newton iterations per step before the step is cut.
-    pub max_iterations: usize,
-    /// First load step Δλ (1: try the full load at once).
-    pub initial_step: f64,
-    /// Smallest load step before giving up.
-    pub min_step: f64,
-    /// Largest number of converged steps.
-    pub max_steps: usize,
-    /// Load or arc-length control.
-    pub path: PathControl,
-}
-
-impl Default for StaticSettings {
-    fn default() -> Self {
-        StaticSettings {
-            tolerance: 1e-10,
-            max_iterations: 20,
-            initial_step: 1.0,
-            min_step: 1e-5,
-            max_steps: 500,
-            path: PathControl::Load,
-        }
-    }
-}
-
-impl StaticSettings {
-    /// Check the values.
-    ///
-    /// # Errors
-    /// A value out of range, named.
-    pub fn validate(&self) -> Result<(), MechanicsError> {
-        let bad =
-            |field: &str, why: &str| Err(MechanicsError::invalid(format!("solver.{field}"), why));
-        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return bad("tolerance", "must be in (0, 1)");
-        }
-        if self.max_iterations == 0 {
-            return bad("max_iterations", "must be at least 1");
-        }
-        if !(self.initial_step > 0.0 && self.initial_step <= 1.0) {
-            return bad("initial_step", "must be in (0, 1]");
-        }
-        if !(self.min_step > 0.0 && self.min_step <= self.initial_step) {
-            return bad("min_step", "must be in (0, initial_step]");
-        }
-        if self.max_steps == 0 {
-            return bad("max_steps", "must be at least 1");
-        }
-        Ok(())
-    }
-}
-
-/// One converged load step.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct StepRecord {
-    /// Load factor at the end of the step.
-    pub load_factor: f64,
-    /// Newton iterations of the step.
-    pub iterations: usize,
-    /// `‖F‖∞` before each iteration (the last one converged).
-    pub residuals: Vec<f64>,
-}
-
-/// The result of a static solve.
-#[derive(Debug, Clone)]
-pub struct StaticSolution {
-    /// The last converged state.
-    pub state: State,
-    /// Its load factor.
-    pub load_factor: f64,
-    /// How the solve ended.
-    pub termination: StaticTermination,
-    /// Converged steps, in order.
-    pub steps: Vec<StepRecord>,
-    /// Newton iterations in all, failed steps included.
-    pub newton_iterations: usize,
-    /// Steps that were cut.
-    pub rejected_steps: usize,
-    /// Support reactions per node (force N, moment N·m; zero where free).
-    pub reactions: Vec<[f64; 6]>,
-    /// Wall time, s.
-    pub time_s: f64,
-}
-
-impl StaticSolution {
-    /// True at equilibrium under the full load.
-    pub fn converged(&self) -> bool {
-        self.termination == StaticTermination::Converged
-    }
-}
-
-/// A static solver for one model: the structure is analysed once, then any
-/// number of solves (new loads through [`StaticSolver::model_mut`]).
-pub struct StaticSolver {
-    model: Model,
-    system: System,
-    /// Size of the frame, m.
-    length_scale: f64,
-    /// Largest coordinate magnitude, m (sets the roundoff of positions).
-    coordinate_scale: f64,
-}
-
-/// Largest ratio of a Newton correction to the increment before it (weighted
-/// norm) for a load step to count as converging on its branch: with every
-/// ratio at most ½ the corrections sum to at most the predictor, so the
-/// converged point lies within `‖δ₀‖` of the predicted one, `u + K⁻¹ Δλ f̂`,
-/// and the step's increment within twice the predictor — the most a smooth
-/// branch gives over a step that ends before a fold (`u − u* ∝ √(λ* − λ)`).
-/// Newton across a limit point bounces: a correction past the fold is larger
-/// than the increment that reached it. ½ is the usual contraction bound of
-/// affine-invariant Newton monitors (Deuflhard, Newton Methods for Nonlinear
-/// Problems, 2004).
-const CONTRACTION: f64 = 0.5;
-
-/// Corrections below this fraction of the predictor are not tested for
-/// contraction. A correction that changes branch moves Newton by about the
-/// distance between the branches, as large as the predictor or larger (a von
-/// Mises truss past its limit: 0.76–0.95 of it in the first correction),
-/// while Newton on a stable but strongly nonlinear path wanders by a few per
-/// cent (a cantilever rolled up by a quarter turn per step: 9 %, after which
-/// it converges quadratically). Measured: 0.2 lets a truss at 30 × its limit
-/// load snap through, 0.1 stops every overload from 1.01 × to 30 ×, and the
-/// full-circle cantilever needs 4 steps with it, 13 with 0.01.
-const CONTRACTION_FLOOR: f64 = 0.1;
-
-/// Largest ratio of a step's tangent predictor per unit load to the previous
-/// step's increment per unit load. Next to a fold the tangent is nearly
-/// singular and throws Newton across the unstable states to the far branch,
-/// where it may converge with contraction. A smooth path's slope changes
-/// little from one step to the next: approaching a quadratic fold, the
-/// tangent's slope over the previous step's secant is `½(1 + √(d₀/d₁))`,
-/// `d₀`, `d₁` the distances in λ to the fold before and after that step, and
-/// reaches 10 only when the step cut the distance by 361.
-const BRANCH_RATIO: f64 = 10.0;
-
-/// A curvature `vᵀ H v` counts as negative below `−CURVATURE_NOISE` times its
-/// roundoff scale `‖v‖ ‖J v‖`: the LU solve of a tangent of condition up to
-/// ~1e8 (thin tubes, `EA·L²/EI`) leaves ~1e-8 relative error in the Newton
-/// increment.
-const CURVATURE_NOISE: f64 = 1e-6;
-
-/// How Newton iterations at fixed λ ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum NewtonEnd {
-    Converged,
-    /// No convergence within the budget, divergence, or a singular tangent.
-    Failed,
-    /// The tangent predictor (first increment) exceeded the bound it was
-    /// given: the path's slope jumped.
-    Overshoot,
-    /// A correction was more than [`CONTRACTION`] times the increment before
-    /// it: Newton left the neighbourhood of the predicted point.
-    Expanding,
-}
-
-/// The outcome of Newton iterations at fixed λ.
-struct NewtonRun {
-    end: NewtonEnd,
-    iterations: usize,
-    residuals: Vec<f64>,
-    reactions: Vec<[f64; 6]>,
-    /// Weighted norm of the sum of the increments: the step's secant.
-    secant: f64,
-    /// Some increment `δ` had negative curvature `δuᵀ H δu`: Newton passed
-    /// through a state where the structure is unstable.
-    negative_curvature: bool,
-}
-
-/// Why a load step was undone.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Rejection {
-    /// Newton did not converge, with no sign of instability.
-    NotConverged,
-    /// The step left its branch: a snap-through, a jump of the path's slope,
-    /// or a failure through unstable states.
-    OffBranch,
-}
+use super::arc_length;
+use super::assembly::{State, System};
+use super::load_control;
+use super::model::MechanicsError;
+use super::settings::{PathControl, StaticSettings, StaticSolution};
+use super::solver::StaticSolver;
+use super::stability::{self, Stability};
 
 impl StaticSolver {
-    /// Analyse the structure of `model`.
-    ///
-    /// # Errors
-    /// A pattern faer cannot analyse.
-    pub fn new(model: Model) -> Result<Self, MechanicsError> {
-        let system = System::new(&model)?;
-        let (mut lo, mut hi) = (
-            nalgebra::Vector3::repeat(f64::MAX),
-            nalgebra::Vector3::repeat(f64::MIN),
-        );
-        for f in &model.reference {
-            lo = lo.inf(&f.position_m);
-            hi = hi.sup(&f.position_m);
-        }
-        let length_scale = (hi - lo).norm().max(1e-9);
-        let coordinate_scale = lo.amax().max(hi.amax());
-        Ok(StaticSolver {
-            model,
-            system,
-            length_scale,
-            coordinate_scale,
-        })
-    }
-
-    /// The model.
-    pub fn model(&self) -> &Model {
-        &self.model
-    }
-
-    /// The model, to change its loads.
-    pub fn model_mut(&mut self) -> &mut Model {
-        &mut self.model
-    }
-
-    /// Largest component of the reference loads.
-    fn load_scale(&self) -> f64 {
-        self.model
-            .loads
-            .iter()
-            .map(|l| l.force_n.amax().max(l.moment_nm.amax()))
-            .fold(0.0, f64::max)
-    }
-
-    /// The unstressed reference state.
-    pub fn reference_state(&self) -> State {
-        self.system.reference_state(&self.model)
-    }
-
-    /// Newton iterations at fixed load factor `lambda`, updating `state`;
-    /// increments measured in the weighted norm `w`, the first one bounded
-    /// by `max_predictor`, each later one by [`CONTRACTION`] times the one
-    /// before.
-    ///
-    /// Each increment `δ` solves `J δ = −R`; its curvature
-    /// `δuᵀ H δu = −δuᵀF + δμᵀ(s g)` follows from the two block rows of `J`
-    /// at no cost.
-    fn newton(
-        &self,
-        state: &mut State,
-        lambda: f64,
-        settings: &StaticSettings,
-        w: &[f64],
-        max_predictor: Option<f64>,
-    ) -> NewtonRun {
-        let n_free = self.system.n_free;
-        let mut run = NewtonRun {
-            end: NewtonEnd::Failed,
-            iterations: 0,
-            residuals: Vec::new(),
-            reactions: vec![],
-            secant: 0.0,
-            negative_curvature: false,
-        };
-        let mut increment = vec![0.0; self.system.n_rows];
-        let (mut predictor, mut previous) = (0.0, 0.0);
-        let mut first = f64::NAN;
-        for it in 0..=settings.max_iterations {
-            let ev = self.system.evaluate(&self.model, state, lambda);
-            let (force, converged) = self.converged(&ev, lambda, settings);
-            run.residuals.push(force);
-            run.iterations = it;
-            if !force.is_finite() {
-                break;
-            }
-            if converged {
-                run.end = NewtonEnd::Converged;
-                run.reactions = ev.reactions;
-                break;
-            }
-            if it == 0 {
-                first = force;
-            } else if force > 1e8 * first {
-                break; // diverging
-            }
-            if it == settings.max_iterations {
-                break;
-            }
-            let Ok(lu) = self.system.factor(&ev.values) else {
-                break;
-            };
-            let mut rhs = self.system.column(&ev.residual);
-            System::solve_in_place(&lu, rhs.as_mut());
-            let delta: Vec<f64> = (0..self.system.n_rows).map(|i| -rhs[(i, 0)]).collect();
-            if !delta.iter().all(|d| d.is_finite()) {
-                break;
-            }
-            let curvature: f64 = delta
-                .iter()
-                .zip(&ev.residual)
-                .enumerate()
-                .map(|(i, (d, r))| if i < n_free { -d * r } else { d * r })
-                .sum();
-            if curvature < -CURVATURE_NOISE * norm(&delta) * norm(&ev.residual) {
-                run.negative_curvature = true;
-            }
-            let size = wdot(w, &delta, &delta).sqrt();
-            let Some(max_predictor) = max_predictor else {
-                // No branch tests: the step is not driven by dead loads.
-                self.system.apply(state, &delta, 1.0);
-                continue;
-            };
-            if it == 0 {
-                predictor = size;
-                if predictor > max_predictor {
-                    run.iterations = 1;
-                    run.end = NewtonEnd::Overshoot;
-                    break;
-                }
-            } else if size > CONTRACTION * previous && size > CONTRACTION_FLOOR * predictor {
-                run.iterations = it + 1;
-                run.end = NewtonEnd::Expanding;
-                break;
-            }
-            previous = size;
-            for (a, d) in increment.iter_mut().zip(&delta) {
-                *a += d;
-            }
-            self.system.apply(state, &delta, 1.0);
-        }
-        run.secant = wdot(w, &increment, &increment).sqrt();
-        run
-    }
-
-    /// The force residual `‖F‖∞` at an evaluation and whether it is converged:
-    /// `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞, cable forces)` and joint gaps `≤ tol · L`,
-    /// where the force test never asks for less than the roundoff of the
-    /// assembled forces, `ε · (EA/L)_max · |x|_max` (coordinates of tens of
-    /// metres and stiff tubes put it near 1e-7 N).
-    pub(crate) fn converged(
-        &self,
-        ev: &Evaluation,
-        lambda: f64,
-        settings: &StaticSettings,
-    ) -> (f64, bool) {
-        let n = self.system.n_free;
-        let force = ev.residual[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let gap = ev.residual[n..].iter().fold(0.0f64, |m, v| m.max(v.abs())) / self.system.scale;
-        if !(force.is_finite() && gap.is_finite()) {
-            return (f64::NAN, false);
-        }
-        let reaction_scale = ev
-            .reactions
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        let roundoff =
-            64.0 * f64::EPSILON * (ev.internal_scale + self.system.scale * self.coordinate_scale);
-        let force_scale = (self.load_scale() * lambda.abs())
-            .max(reaction_scale)
-            .max(ev.prestress_scale);
-        let tol = (settings.tolerance * force_scale).max(roundoff);
-        (
-            force,
-            force <= tol && gap <= settings.tolerance * self.length_scale,
-        )
-    }
-
     /// Solve from the reference configuration under the model's loads.
     ///
     /// # Errors
@@ -474,143 +38,15 @@ impl StaticSolver {
     ) -> Result<StaticSolution, MechanicsError> {
         settings.validate()?;
         match settings.path {
-            PathControl::Load => Ok(self.load_control(start, start_load_factor, settings)),
-            PathControl::ArcLength => Ok(self.arc_length(start, start_load_factor, settings)),
-        }
-    }
-
-    /// Load control: `λ` ramped from `lambda0` to 1 in adaptive steps.
-    ///
-    /// A step is accepted when Newton converges *on the branch the step
-    /// started from*, that is from its tangent predictor `K⁻¹ Δλ f̂` (the
-    /// first Newton increment) without moving away from the predicted point.
-    /// Two tests, on increments Newton computes anyway (weighted norm of the
-    /// arc-length method, rotations × mean element length), stop a step:
-    ///
-    /// 1. contraction: a correction more than [`CONTRACTION`] times the
-    ///    increment before it. Passing it, the converged point lies within
-    ///    the predictor's length of the predicted point. Past a limit point
-    ///    Newton bounces through the unstable states to the snapped-through
-    ///    branch, and fails it;
-    /// 2. slope jump: a predictor per unit load more than [`BRANCH_RATIO`]
-    ///    times the previous step's increment per unit load — next to a fold
-    ///    the tangent is nearly singular and throws Newton across the
-    ///    unstable states, where it may then contract onto the far branch.
-    ///
-    /// A stopped step is undone and cut ÷4 like one that does not converge;
-    /// a smooth branch always passes once the step is short enough. Beyond a
-    /// limit load no step passes, however short: when the step falls below
-    /// `min_step` the solve ends with [`StaticTermination::LimitPoint`] at the
-    /// last converged `λ` if the last try was stopped by a test or failed
-    /// through negative curvature `δuᵀ H δu < 0` (an unstable state), and
-    /// with [`StaticTermination::Stalled`] if Newton simply did not converge.
-    /// Without these tests Newton under a load beyond the limit converges on
-    /// a snapped-through equilibrium (a von Mises truss inverted) and reports
-    /// it as the answer.
-    ///
-    /// What no finite step can see: a fold passed inside one step whose
-    /// predictor lands near the far branch — a load tens of times the limit
-    /// load applied in one step (a von Mises truss at 60 × its limit load
-    /// converges inverted). Ramp such loads (`initial_step`) or use arc
-    /// length.
-    ///
-    /// What passes: large but stable rotations (a cantilever rolled up twice,
-    /// in steps short enough for Newton to contract), and a branch continued
-    /// smoothly past a bifurcation — a symmetric structure beyond a buckling
-    /// load stays on its unstable fundamental branch when Newton reaches it
-    /// where the tangent points. Load control does not certify stability;
-    /// arc length finds where the path turns.
-    fn load_control(
-        &self,
-        start: State,
-        lambda0: f64,
-        settings: &StaticSettings,
-    ) -> StaticSolution {
-        let clock = Instant::now();
-        let w = weights(self, &self.system);
-        let mut state = start;
-        let mut lambda = lambda0;
-        let mut step = settings.initial_step;
-        let mut steps = Vec::new();
-        let mut newton_iterations = 0;
-        let mut rejected_steps = 0;
-        let mut reactions = vec![[0.0; 6]; self.model.node_count()];
-        // The path's slope over the last accepted step (none yet: no bound).
-        let mut previous_slope = f64::INFINITY;
-        // The branch tests follow the path of dead loads; a structure loaded
-        // only by its prestrain (an assembled cable net) has no such path.
-        let dead_loads = self.load_scale() > 0.0;
-        let termination = loop {
-            if lambda >= 1.0 {
-                break StaticTermination::Converged;
-            }
-            if steps.len() >= settings.max_steps {
-                break StaticTermination::MaxSteps {
-                    load_factor: lambda,
-                };
-            }
-            let target = (lambda + step).min(1.0);
-            let d_lambda = target - lambda;
-            let mut trial = state.clone();
-            let run = self.newton(
-                &mut trial,
-                target,
+            PathControl::Load => Ok(load_control::follow(
+                self,
+                start,
+                start_load_factor,
                 settings,
-                &w,
-                dead_loads.then_some(BRANCH_RATIO * previous_slope * d_lambda),
-            );
-            newton_iterations += run.iterations;
-            let verdict = match run.end {
-                NewtonEnd::Converged => Ok(run.secant / d_lambda),
-                NewtonEnd::Overshoot | NewtonEnd::Expanding => Err(Rejection::OffBranch),
-                NewtonEnd::Failed if run.negative_curvature && dead_loads => {
-                    Err(Rejection::OffBranch)
-                }
-                NewtonEnd::Failed => Err(Rejection::NotConverged),
-            };
-            match verdict {
-                Ok(slope) => {
-                    // A step that converged at once says nothing of the slope.
-                    previous_slope = if slope > 0.0 { slope } else { f64::INFINITY };
-                    state = trial;
-                    lambda = target;
-                    reactions = run.reactions;
-                    if run.iterations <= 4 {
-                        step = (2.0 * step).min(1.0);
-                    } else if run.iterations > 10 {
-                        step *= 0.5;
-                    }
-                    steps.push(StepRecord {
-                        load_factor: lambda,
-                        iterations: run.iterations,
-                        residuals: run.residuals,
-                    });
-                }
-                Err(why) => {
-                    rejected_steps += 1;
-                    step *= 0.25;
-                    if step < settings.min_step {
-                        break match why {
-                            Rejection::OffBranch => StaticTermination::LimitPoint {
-                                limit_load_factor: lambda,
-                            },
-                            Rejection::NotConverged => StaticTermination::Stalled {
-                                load_factor: lambda,
-                            },
-                        };
-                    }
-                }
+            )),
+            PathControl::ArcLength => {
+                Ok(arc_length::follow(self, start, start_load_factor, settings))
             }
-        };
-        StaticSolution {
-            state,
-            load_factor: lambda,
-            termination,
-            steps,
-            newton_iterations,
-            rejected_steps,
-            reactions,
-            time_s: clock.elapsed().as_secs_f64(),
         }
     }
 
@@ -621,47 +57,32 @@ impl StaticSolver {
     /// [`MechanicsError::Mechanism`] when `K₀` is singular.
     pub fn linear_response(&self) -> Result<State, MechanicsError> {
         let mut state = self.reference_state();
-        let ev = self.system.evaluate(&self.model, &state, 1.0);
+        let ev = self.system().evaluate(self.model(), &state, 1.0);
         let lu = self
-            .system
+            .system()
             .factor(&ev.values)
-            .map_err(|detail| MechanicsError::Mechanism { detail })?;
-        let mut rhs = self.system.column(&ev.residual);
+            .map_err(|e| MechanicsError::Mechanism {
+                detail: e.to_string(),
+            })?;
+        let mut rhs = self.system().column(&ev.residual);
         System::solve_in_place(&lu, rhs.as_mut());
-        let delta: Vec<f64> = (0..self.system.n_rows).map(|i| -rhs[(i, 0)]).collect();
+        let delta: Vec<f64> = (0..self.system().n_rows).map(|i| -rhs[(i, 0)]).collect();
         if !delta.iter().all(|d| d.is_finite()) {
             return Err(MechanicsError::Mechanism {
                 detail: "the linear solve gave non-finite displacements".into(),
             });
         }
-        self.system.apply(&mut state, &delta, 1.0);
+        self.system().apply(&mut state, &delta, 1.0);
         Ok(state)
     }
 
     /// The stability of `state`, an equilibrium at load factor `lambda`: is
-    /// the stiffness positive definite on the joints' constraints
-    /// ([`super::stability`])?
+    /// the stiffness positive definite on the joints' constraints (inverse
+    /// iteration with the tangent's factor)?
     ///
     /// # Errors
     /// A tangent that cannot be factored (a mechanism, or exactly critical).
-    pub fn stability(
-        &self,
-        state: &State,
-        lambda: f64,
-    ) -> Result<super::stability::Stability, MechanicsError> {
-        super::stability::stability(self, &self.system, state, lambda)
+    pub fn stability(&self, state: &State, lambda: f64) -> Result<Stability, MechanicsError> {
+        stability::stability(self, state, lambda)
     }
-
-    fn arc_length(&self, start: State, lambda0: f64, settings: &StaticSettings) -> StaticSolution {
-        super::arc_length::follow(self, &self.system, start, lambda0, settings)
-    }
-
-    pub(crate) fn length_scale(&self) -> f64 {
-        self.length_scale
-    }
-}
-
-/// Euclidean norm.
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }

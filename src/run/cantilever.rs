@@ -3,8 +3,9 @@
 
 use serde::Serialize;
 
-use crate::mechanics::cantilever::{self, CantileverRow};
-use crate::mechanics::{ElementKind, FrameFileError};
+use crate::frame::cantilever::{self, CantileverRow};
+use crate::frame::FrameFileError;
+use crate::mechanics::ElementKind;
 use crate::Error;
 
 /// One row of `ringmesh cantilever`: the engine's row and the paper's result

@@ -6,9 +6,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::algebra::norm3;
-use crate::mechanics::{
-    rotation, FrameFile, FrameFileError, NodeOrigin, StaticSolver, StaticTermination, StepRecord,
-};
+use crate::frame::{FrameFile, FrameFileError, NodeOrigin};
+use crate::mechanics::{rotation, StaticSolver, StaticTermination, StepRecord};
 use crate::report::write_json;
 use crate::Error;
 

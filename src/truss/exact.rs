@@ -9,9 +9,8 @@ use std::time::Instant;
 
 use nalgebra::Vector3;
 
-use super::{
-    layout_points, set_attachment_loads, RingTruss, TrussError, TrussOracle, TrussResponse,
-};
+use super::builder::RingTruss;
+use super::response::{check_loads, layout_points, TrussError, TrussOracle, TrussResponse};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::{NodalLoad, NodeId, State, StaticSettings, StaticSolver};
 
@@ -142,4 +141,20 @@ impl TrussOracle for ExactTruss {
         self.previous = Some(solution.state);
         Ok(response)
     }
+}
+
+/// Check `loads_n` against the attachment points and set them, with the
+/// truss's `self_weight`, as the dead loads of `solver`'s frame (forces at
+/// the hinge bodies `attachments`).
+pub(super) fn set_attachment_loads(
+    solver: &mut crate::mechanics::StaticSolver,
+    attachments: &[crate::mechanics::NodeId],
+    self_weight: &[crate::mechanics::NodalLoad],
+    loads_n: &[[f64; 3]],
+) -> Result<(), TrussError> {
+    check_loads(loads_n, attachments.len())?;
+    let mut loads = nodal_loads(attachments, loads_n);
+    loads.extend_from_slice(self_weight);
+    solver.model_mut().set_loads(loads)?;
+    Ok(())
 }

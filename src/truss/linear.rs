@@ -3,9 +3,9 @@
 
 use std::time::Instant;
 
-use super::{
-    layout_points, set_attachment_loads, RingTruss, TrussError, TrussOracle, TrussResponse,
-};
+use super::builder::RingTruss;
+use super::exact::set_attachment_loads;
+use super::response::{layout_points, TrussError, TrussOracle, TrussResponse};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::{NodalLoad, StaticSolver};
 

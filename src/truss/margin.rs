@@ -5,10 +5,12 @@
 //! The one-step equilibrium the design loop asks of the exact truss cannot
 //! tell a stable state from one past a bifurcation: a ring under a symmetric
 //! pull stays on its symmetric branch past its buckling load. The margin is
-//! found on the state instead ([`crate::mechanics::stability`]): the pull is
+//! found on the state instead ([`crate::mechanics::Stability`]): the pull is
 //! multiplied by 1, 2, 4 until the equilibrium is unstable, then bisected.
 
-use super::{check_loads, exact::nodal_loads, RingTruss, TrussError};
+use super::builder::RingTruss;
+use super::exact::nodal_loads;
+use super::response::{check_loads, TrussError};
 use crate::mechanics::{limit_load_factor, LimitSearch, StaticSettings, StaticSolver};
 
 /// How far the margin is searched: a truss stable at this multiple of the

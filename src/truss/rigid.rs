@@ -1,6 +1,6 @@
 //! The rigid truss: attachment points never move (the conventional method).
 
-use super::{check_loads, layout_points, TrussError, TrussOracle, TrussResponse};
+use super::response::{check_loads, layout_points, TrussError, TrussOracle, TrussResponse};
 use crate::geometry::RingTrussLayout;
 
 /// A ring truss that does not deform.

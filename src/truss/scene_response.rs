@@ -1,4 +1,5 @@
-//! The `truss` command's work: a scene's truss model under the pull of its net
+//! The `truss` command's work: a scene's truss model (built by the registry,
+//! [`super::oracle`]) under the pull of its net
 //! (forward FDM with the net's initial q) or under loads read from a file,
 //! reported per attachment point.
 
@@ -6,7 +7,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{oracle, TrussError};
+use super::registry::oracle;
+use super::response::TrussError;
 use crate::effects::SceneEffects;
 use crate::fdm::solve_network;
 use crate::geometry::build_mesh;

@@ -2,7 +2,7 @@
 //! to its unstressed length `L₀ = ℓ/(1 + T/EA)`, attached to the *undeformed*
 //! truss, and the whole solved to static equilibrium — what will be built.
 //!
-//! The cables are tension-only elastic elements ([`crate::mechanics::cable`]);
+//! The cables are tension-only elastic elements ([`crate::mechanics::Cable`]);
 //! their prestrain is ramped as load steps from the stress-free assembly
 //! (cables at the distance of their end points) to the cut lengths. The truss
 //! is either rigid (the attachment points held where the layout puts them)

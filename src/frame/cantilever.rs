@@ -5,9 +5,9 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::beam::{ElementKind, Section};
-use super::model::{MechanicsError, ModelBuilder, RodSpec};
-use super::statics::{StaticSettings, StaticSolver};
+use crate::mechanics::{
+    ElementKind, MechanicsError, ModelBuilder, RodSpec, Section, StaticSettings, StaticSolver,
+};
 
 /// Length of the cantilever (paper §3.4).
 pub const LENGTH_M: f64 = 10.0;

@@ -1,0 +1,175 @@
+//! What a static solve takes and returns, as plain data: the settings
+//! ([`StaticSettings`], [`PathControl`]) and the solution ([`StaticSolution`],
+//! its [`StepRecord`]s and how it ended, [`StaticTermination`]).
+
+use serde::Serialize;
+
+use super::assembly::State;
+use super::model::MechanicsError;
+
+/// How a static solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum StaticTermination {
+    /// Equilibrium at the full load (λ = 1).
+    Converged,
+    /// The load step fell below the minimum before λ = 1, Newton failing to
+    /// converge without a sign of instability: the last converged load factor
+    /// is in the solution.
+    Stalled {
+        /// Last converged load factor.
+        load_factor: f64,
+    },
+    /// The structure cannot carry the full load on the branch it started on:
+    /// its limit load is about `limit_load_factor` × the applied loads.
+    ///
+    /// Arc length: the path passed a maximum of the load factor below 1, and
+    /// `limit_load_factor` is the largest on the path. Load control: the step
+    /// was cut below the minimum because every try beyond `limit_load_factor`
+    /// left the branch — Newton moved away from the tangent's prediction
+    /// (towards a snapped-through branch), the path's slope jumped tenfold, or
+    /// Newton failed through unstable states; the limit lies within a few
+    /// minimum steps above it.
+    LimitPoint {
+        /// The largest load factor reached on the branch.
+        limit_load_factor: f64,
+    },
+    /// The step budget ran out.
+    MaxSteps {
+        /// Last converged load factor.
+        load_factor: f64,
+    },
+}
+
+impl std::fmt::Display for StaticTermination {
+    /// One clause a person can read: `passed a limit point at load factor
+    /// 0.6555 (the structure carries about 0.6555 × the applied loads)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StaticTermination::Converged => f.write_str("converged at the full load"),
+            StaticTermination::Stalled { load_factor } => write!(
+                f,
+                "stalled: Newton stopped converging at load factor {load_factor:.4}, with no \
+                 sign of instability"
+            ),
+            StaticTermination::LimitPoint { limit_load_factor } => write!(
+                f,
+                "passed a limit point at load factor {limit_load_factor:.4} (the structure \
+                 carries about {limit_load_factor:.4} × the applied loads)"
+            ),
+            StaticTermination::MaxSteps { load_factor } => {
+                write!(f, "ran out of load steps at load factor {load_factor:.4}")
+            }
+        }
+    }
+}
+
+/// How the load is followed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PathControl {
+    /// Load control: λ ramped to 1 with adaptive steps.
+    #[default]
+    Load,
+    /// Arc-length control (cylindrical, Crisfield): follows the path through
+    /// limit points.
+    ArcLength,
+}
+
+/// Settings of the static solver: plain data with defaults.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StaticSettings {
+    /// Relative force tolerance: `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞,
+    /// largest cable force)`.
+    pub tolerance: f64,
+    /// Newton iterations per step before the step is cut.
+    pub max_iterations: usize,
+    /// First load step Δλ (1: try the full load at once).
+    pub initial_step: f64,
+    /// Smallest load step before giving up.
+    pub min_step: f64,
+    /// Largest number of converged steps.
+    pub max_steps: usize,
+    /// Load or arc-length control.
+    pub path: PathControl,
+}
+
+impl Default for StaticSettings {
+    fn default() -> Self {
+        StaticSettings {
+            tolerance: 1e-10,
+            max_iterations: 20,
+            initial_step: 1.0,
+            min_step: 1e-5,
+            max_steps: 500,
+            path: PathControl::Load,
+        }
+    }
+}
+
+impl StaticSettings {
+    /// Check the values.
+    ///
+    /// # Errors
+    /// A value out of range, named.
+    pub fn validate(&self) -> Result<(), MechanicsError> {
+        let bad =
+            |field: &str, why: &str| Err(MechanicsError::invalid(format!("solver.{field}"), why));
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return bad("tolerance", "must be in (0, 1)");
+        }
+        if self.max_iterations == 0 {
+            return bad("max_iterations", "must be at least 1");
+        }
+        if !(self.initial_step > 0.0 && self.initial_step <= 1.0) {
+            return bad("initial_step", "must be in (0, 1]");
+        }
+        if !(self.min_step > 0.0 && self.min_step <= self.initial_step) {
+            return bad("min_step", "must be in (0, initial_step]");
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", "must be at least 1");
+        }
+        Ok(())
+    }
+}
+
+/// One converged load step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StepRecord {
+    /// Load factor at the end of the step.
+    pub load_factor: f64,
+    /// Newton iterations of the step.
+    pub iterations: usize,
+    /// `‖F‖∞` before each iteration (the last one converged).
+    pub residuals: Vec<f64>,
+}
+
+/// The result of a static solve.
+#[derive(Debug, Clone)]
+pub struct StaticSolution {
+    /// The last converged state.
+    pub state: State,
+    /// Its load factor.
+    pub load_factor: f64,
+    /// How the solve ended.
+    pub termination: StaticTermination,
+    /// Converged steps, in order.
+    pub steps: Vec<StepRecord>,
+    /// Newton iterations in all, failed steps included.
+    pub newton_iterations: usize,
+    /// Steps that were cut.
+    pub rejected_steps: usize,
+    /// Support reactions per node (force N, moment N·m; zero where free).
+    pub reactions: Vec<[f64; 6]>,
+    /// Wall time, s.
+    pub time_s: f64,
+}
+
+impl StaticSolution {
+    /// True at equilibrium under the full load.
+    pub fn converged(&self) -> bool {
+        self.termination == StaticTermination::Converged
+    }
+}

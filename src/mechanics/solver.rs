@@ -1,0 +1,137 @@
+//! The static solver's core, shared by every algorithm that follows the
+//! equilibrium path (load control, arc length, the stability test): the
+//! solver (the model, its assembled system, its length and coordinate
+//! scales), the convergence test, and the weighted norm of increments in
+//! which steps are measured — rotations weighted by the mean element length
+//! so that both are lengths, multipliers not counted.
+
+use super::assembly::{Evaluation, State, System};
+use super::model::{MechanicsError, Model};
+use super::settings::StaticSettings;
+use crate::algebra::norm_inf;
+
+/// A static solver for one model: the structure is analysed once, then any
+/// number of solves (new loads through [`StaticSolver::model_mut`]).
+pub struct StaticSolver {
+    model: Model,
+    system: System,
+    /// Size of the frame, m.
+    length_scale: f64,
+    /// Largest coordinate magnitude, m (sets the roundoff of positions).
+    coordinate_scale: f64,
+}
+
+impl StaticSolver {
+    /// Analyse the structure of `model`.
+    ///
+    /// # Errors
+    /// A pattern faer cannot analyse.
+    pub fn new(model: Model) -> Result<Self, MechanicsError> {
+        let system = System::new(&model)?;
+        let (mut lo, mut hi) = (
+            nalgebra::Vector3::repeat(f64::MAX),
+            nalgebra::Vector3::repeat(f64::MIN),
+        );
+        for f in &model.reference {
+            lo = lo.inf(&f.position_m);
+            hi = hi.sup(&f.position_m);
+        }
+        let length_scale = (hi - lo).norm().max(1e-9);
+        let coordinate_scale = lo.amax().max(hi.amax());
+        Ok(StaticSolver {
+            model,
+            system,
+            length_scale,
+            coordinate_scale,
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The model, to change its loads.
+    pub fn model_mut(&mut self) -> &mut Model {
+        &mut self.model
+    }
+
+    /// Largest component of the reference loads.
+    pub(super) fn load_scale(&self) -> f64 {
+        self.model
+            .loads
+            .iter()
+            .map(|l| l.force_n.amax().max(l.moment_nm.amax()))
+            .fold(0.0, f64::max)
+    }
+
+    /// The unstressed reference state.
+    pub fn reference_state(&self) -> State {
+        self.system.reference_state(&self.model)
+    }
+
+    /// The assembled system: dof numbering, pattern, symbolic LU.
+    pub(super) fn system(&self) -> &System {
+        &self.system
+    }
+
+    /// The force residual `‖F‖∞` at an evaluation and whether it is converged:
+    /// `‖F‖∞ ≤ tol · max(λ‖f_ext‖∞, ‖reactions‖∞, cable forces)` and joint gaps `≤ tol · L`,
+    /// where the force test never asks for less than the roundoff of the
+    /// assembled forces, `ε · (EA/L)_max · |x|_max` (coordinates of tens of
+    /// metres and stiff tubes put it near 1e-7 N).
+    pub(super) fn converged(
+        &self,
+        ev: &Evaluation,
+        lambda: f64,
+        settings: &StaticSettings,
+    ) -> (f64, bool) {
+        let n = self.system.n_free;
+        let force = norm_inf(&ev.residual[..n]);
+        let gap = norm_inf(&ev.residual[n..]) / self.system.scale;
+        if !(force.is_finite() && gap.is_finite()) {
+            return (f64::NAN, false);
+        }
+        let reaction_scale = norm_inf(ev.reactions.as_flattened());
+        let roundoff =
+            64.0 * f64::EPSILON * (ev.internal_scale + self.system.scale * self.coordinate_scale);
+        let force_scale = (self.load_scale() * lambda.abs())
+            .max(reaction_scale)
+            .max(ev.prestress_scale);
+        let tol = (settings.tolerance * force_scale).max(roundoff);
+        (
+            force,
+            force <= tol && gap <= settings.tolerance * self.length_scale,
+        )
+    }
+
+    /// Weights of the weighted norm: 1 on translations, `ℓ` (the mean
+    /// element length) on rotations, 0 on multipliers.
+    pub(super) fn weights(&self) -> Vec<f64> {
+        let model = &self.model;
+        let system = &self.system;
+        let mean_length = if model.elements.is_empty() {
+            self.length_scale
+        } else {
+            model.elements.iter().map(|e| e.length_m).sum::<f64>() / model.elements.len() as f64
+        };
+        let mut w = vec![0.0; system.n_rows];
+        for n in 0..model.node_count() {
+            for c in 0..6 {
+                if let Some(i) = system.unknown(n, c) {
+                    w[i] = if c < 3 { 1.0 } else { mean_length };
+                }
+            }
+        }
+        w
+    }
+}
+
+/// The weighted dot product `Σ wᵢ² aᵢ bᵢ` (weights of [`StaticSolver::weights`]).
+pub(super) fn wdot(w: &[f64], a: &[f64], b: &[f64]) -> f64 {
+    w.iter()
+        .zip(a)
+        .zip(b)
+        .map(|((w, a), b)| w * w * a * b)
+        .sum()
+}
