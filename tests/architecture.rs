@@ -2,9 +2,9 @@
 //! the top-level modules or between the files of one module. A file's
 //! dependencies are read from its `crate::…` and `super::…` paths, items
 //! re-exported by a `mod.rs` followed to the file that defines them; the
-//! crate root (`lib.rs`, which joins every module's error) and the edges
-//! between a `mod.rs` and the files below it (declarations, re-exports) are
-//! left out.
+//! crate root (`lib.rs`, which joins every module's error), the edges
+//! between a `mod.rs` and the files below it (declarations, re-exports) and
+//! unit tests (which may use any layer) are left out.
 
 mod common;
 
@@ -149,7 +149,8 @@ impl Crate {
         let mut exports = BTreeMap::new();
         let mut uses = BTreeMap::new();
         for path in paths {
-            if path.ends_with("main.rs") {
+            // The binary, and unit-test modules kept in a file of their own.
+            if path.ends_with("main.rs") || path.ends_with("tests.rs") {
                 continue;
             }
             let module = module_of(&path);

@@ -157,10 +157,15 @@ fn an_interrupted_write_leaves_the_previous_file_whole() {
     ringmesh::report::write_json(&path, &vec![1, 2, 3]).unwrap();
     let before = std::fs::read(&path).unwrap();
     let result = ringmesh::report::write_atomic_with(&path, |temporary| {
-        std::fs::write(temporary, b"[4, 5").map_err(|e| e.to_string())?;
-        Err("interrupted".to_string())
+        std::fs::write(temporary, b"[4, 5")?;
+        Err("interrupted".into())
     });
-    assert_eq!(result, Err("interrupted".to_string()));
+    match result {
+        Err(ringmesh::report::ReportError::Plot { source, .. }) => {
+            assert_eq!(source.to_string(), "interrupted")
+        }
+        other => panic!("{other:?}"),
+    }
     assert_eq!(std::fs::read(&path).unwrap(), before);
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }

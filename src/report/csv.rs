@@ -86,7 +86,7 @@ pub fn front_csv(rows: &[FrontRow]) -> String {
 ///
 /// # Errors
 /// A line that is not one, with the reason.
-pub fn parse_front_row(line: &str) -> Result<FrontRow, String> {
+pub fn parse_front_row(line: &str) -> Result<FrontRow, RowError> {
     let f = split_row(line, 5)?;
     Ok(FrontRow {
         solver: f[0].clone(),
@@ -162,9 +162,9 @@ pub fn study_csv(rows: &[StudyRow]) -> String {
 ///
 /// # Errors
 /// A line that is not one, with the reason.
-pub fn parse_study_row(line: &str) -> Result<StudyRow, String> {
+pub fn parse_study_row(line: &str) -> Result<StudyRow, RowError> {
     let f = split_row(line, 20)?;
-    let optional = |text: &str, name: &str| -> Result<f64, String> {
+    let optional = |text: &str, name: &'static str| -> Result<f64, RowError> {
         if text.is_empty() {
             Ok(f64::NAN)
         } else {
@@ -172,19 +172,19 @@ pub fn parse_study_row(line: &str) -> Result<StudyRow, String> {
         }
     };
     let truss = <TrussModel as clap::ValueEnum>::from_str(&f[5], false)
-        .map_err(|_| format!("unknown truss model {:?}", f[5]))?;
+        .map_err(|_| RowError::value("truss", &f[5], "truss model"))?;
     let solver = <SolverKind as clap::ValueEnum>::from_str(&f[6], false)
-        .map_err(|_| format!("unknown solver {:?}", f[6]))?;
+        .map_err(|_| RowError::value("solver", &f[6], "solver"))?;
     let termination = if f[9].is_empty() {
         None
     } else {
         Some(
             serde_json::from_value(serde_json::Value::String(f[9].clone()))
-                .map_err(|_| format!("unknown termination {:?}", f[9]))?,
+                .map_err(|_| RowError::value("termination", &f[9], "termination"))?,
         )
     };
     Ok(StudyRow {
-        knob: Knob::from_name(&f[0]).ok_or_else(|| format!("unknown knob {:?}", f[0]))?,
+        knob: Knob::from_name(&f[0]).ok_or_else(|| RowError::value("knob", &f[0], "knob"))?,
         value: f[1].clone(),
         settings: RunSettings {
             tolerance_m: number(&f[2], "tolerance_m")?,
@@ -235,7 +235,7 @@ fn quote(text: &str) -> String {
 }
 
 /// The fields of a CSV line (quoted fields unquoted), exactly `n` of them.
-fn split_row(line: &str, n: usize) -> Result<Vec<String>, String> {
+fn split_row(line: &str, n: usize) -> Result<Vec<String>, RowError> {
     let mut fields = Vec::with_capacity(n);
     let mut field = String::new();
     let mut chars = line.chars().peekable();
@@ -256,18 +256,54 @@ fn split_row(line: &str, n: usize) -> Result<Vec<String>, String> {
     if fields.len() == n {
         Ok(fields)
     } else {
-        Err(format!("{} fields, {n} expected", fields.len()))
+        Err(RowError::FieldCount {
+            found: fields.len(),
+            expected: n,
+        })
     }
 }
 
-fn number(text: &str, name: &str) -> Result<f64, String> {
+fn number(text: &str, name: &'static str) -> Result<f64, RowError> {
     text.parse()
-        .map_err(|_| format!("{name}: {text:?} is not a number"))
+        .map_err(|_| RowError::value(name, text, "number"))
 }
 
-fn whole(text: &str, name: &str) -> Result<usize, String> {
+fn whole(text: &str, name: &'static str) -> Result<usize, RowError> {
     text.parse()
-        .map_err(|_| format!("{name}: {text:?} is not a whole number"))
+        .map_err(|_| RowError::value(name, text, "whole number"))
+}
+
+/// A CSV row of ours that cannot be read back.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RowError {
+    /// Too many or too few fields.
+    #[error("{found} fields, {expected} expected")]
+    FieldCount {
+        /// Fields found.
+        found: usize,
+        /// Fields of the table.
+        expected: usize,
+    },
+    /// A field that is not what its column holds.
+    #[error("{column}: {text:?} is not a {expected}")]
+    Value {
+        /// The column.
+        column: &'static str,
+        /// The field as written.
+        text: String,
+        /// What the column holds (`number`, `solver`, …).
+        expected: &'static str,
+    },
+}
+
+impl RowError {
+    fn value(column: &'static str, text: &str, expected: &'static str) -> Self {
+        RowError::Value {
+            column,
+            text: text.to_string(),
+            expected,
+        }
+    }
 }
 
 /// `relaxation,iteration,…`: one row per outer iteration of every run.

@@ -30,12 +30,12 @@ pub enum ReportError {
         source: std::io::Error,
     },
     /// A plot could not be drawn.
-    #[error("drawing {path}: {message}")]
+    #[error("drawing {path}: {source}")]
     Plot {
         /// The file.
         path: PathBuf,
-        /// The backend's message.
-        message: String,
+        /// The backend's error.
+        source: DrawError,
     },
     /// A value could not be serialised (a non-finite number in JSON, say).
     #[error("serialising {path}: {source}")]
@@ -83,17 +83,29 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
     result.map_err(io)
 }
 
+/// What a drawing fails with: the plotting backend's error.
+pub type DrawError = Box<dyn std::error::Error + Send + Sync>;
+
 /// Lets `draw` write a file at a temporary path (same folder, same extension, so
-/// format-by-extension writers work), then renames it over `path`.
+/// format-by-extension writers work), then renames it over `path`; on any
+/// failure the temporary file is removed and `path` left as it was.
+///
+/// # Errors
+/// The folder or the rename refused ([`ReportError::Io`]), or `draw` failed
+/// ([`ReportError::Plot`]).
 pub fn write_atomic_with(
     path: &Path,
-    draw: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), String> {
+    draw: impl FnOnce(&Path) -> Result<(), DrawError>,
+) -> Result<(), ReportError> {
+    let io = |source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let parent = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    std::fs::create_dir_all(&parent).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(&parent).map_err(io)?;
     let name = path
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
@@ -104,7 +116,11 @@ pub fn write_atomic_with(
         .unwrap_or_default();
     let temporary = parent.join(format!(".{name}.{}.tmp.{extension}", std::process::id()));
     let result = draw(&temporary)
-        .and_then(|()| std::fs::rename(&temporary, path).map_err(|e| e.to_string()));
+        .map_err(|source| ReportError::Plot {
+            path: path.to_path_buf(),
+            source,
+        })
+        .and_then(|()| std::fs::rename(&temporary, path).map_err(io));
     if result.is_err() {
         let _ = std::fs::remove_file(&temporary);
     }

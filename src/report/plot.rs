@@ -7,7 +7,7 @@ use std::sync::Once;
 
 use plotters::prelude::*;
 
-use super::{write_atomic, write_atomic_with, FrontRow, ReportError};
+use super::{write_atomic, write_atomic_with, DrawError, FrontRow, ReportError};
 use crate::study::{pareto_optimal, Knob, StudyRow};
 
 const FONT: &[u8] = include_bytes!("fonts/DejaVuSans.ttf");
@@ -27,12 +27,12 @@ fn draw_front<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     points: &[FrontRow],
     title: &str,
-) -> Result<(), String>
+) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
 {
     let ok: Vec<&FrontRow> = points.iter().filter(|p| p.ratio.is_finite()).collect();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.fill(&WHITE)?;
     let x = |p: &FrontRow| p.rms_mm.max(RMS_FLOOR_MM);
     let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
     for p in &ok {
@@ -51,16 +51,14 @@ where
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d((x_lo..x_hi).log_scale(), y_lo..y_hi)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), y_lo..y_hi)?;
     chart
         .configure_mesh()
         .x_desc("surface RMS from a forward solve (mm)")
         .x_label_formatter(&|v| format!("{v:.0e}"))
         .y_desc("Tmax / Tmin")
         .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     let mut solvers: Vec<&str> = Vec::new();
     for p in &ok {
         if !solvers.contains(&p.solver.as_str()) {
@@ -77,28 +75,24 @@ where
         series.sort_by(|a, b| a.0.total_cmp(&b.0));
         let name = solver.to_string();
         chart
-            .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
-            .map_err(|e| e.to_string())?
+            .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))?
             .label(name)
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
             });
-        chart
-            .draw_series(
-                series
-                    .into_iter()
-                    .map(|p| Circle::new(p, 4, colour.filled())),
-            )
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(
+            series
+                .into_iter()
+                .map(|p| Circle::new(p, 4, colour.filled())),
+        )?;
     }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+        .draw()?;
+    Ok(root.present()?)
 }
 
 /// Draws `$draw(area, args…)` — generic over the plotters backend — as a PNG
@@ -108,17 +102,15 @@ macro_rules! png_and_svg {
     ($draw:ident, $size:expr, $png:expr, $svg:expr $(, $arg:expr)*) => {{
         register_font();
         let (png, svg, size): (&Path, &Path, (u32, u32)) = ($png, $svg, $size);
-        let failure = |path: &Path, message: String| ReportError::Plot {
-            path: path.to_path_buf(),
-            message,
-        };
         write_atomic_with(png, |temporary| {
             $draw(BitMapBackend::new(temporary, size).into_drawing_area() $(, $arg)*)
-        })
-        .map_err(|m| failure(png, m))?;
+        })?;
         let mut text = String::new();
         $draw(SVGBackend::with_string(&mut text, size).into_drawing_area() $(, $arg)*)
-            .map_err(|m| failure(svg, m))?;
+            .map_err(|source| ReportError::Plot {
+                path: svg.to_path_buf(),
+                source,
+            })?;
         write_atomic(svg, text.as_bytes())
     }};
 }
@@ -141,11 +133,11 @@ fn draw_convergence<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     series: &[(String, Vec<(usize, f64)>)],
     title: &str,
-) -> Result<(), String>
+) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.fill(&WHITE)?;
     let values = series
         .iter()
         .flat_map(|(_, s)| s.iter().map(|p| p.1.max(RESIDUAL_FLOOR_M)));
@@ -167,16 +159,14 @@ where
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(0..last.max(1), (lo..hi).log_scale())
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(0..last.max(1), (lo..hi).log_scale())?;
     chart
         .configure_mesh()
         .x_desc("outer iteration")
         .y_desc("max boundary change ‖G(C) − C‖∞ (m)")
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     for (index, (name, points)) in series.iter().enumerate() {
         let colour = Palette99::pick(index).to_rgba();
         let points: Vec<(usize, f64)> = points
@@ -184,28 +174,24 @@ where
             .map(|&(k, v)| (k, v.max(RESIDUAL_FLOOR_M)))
             .collect();
         chart
-            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-            .map_err(|e| e.to_string())?
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
             .label(name.clone())
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
             });
-        chart
-            .draw_series(
-                points
-                    .into_iter()
-                    .map(|p| Circle::new(p, 3, colour.filled())),
-            )
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(
+            points
+                .into_iter()
+                .map(|p| Circle::new(p, 3, colour.filled())),
+        )?;
     }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+        .draw()?;
+    Ok(root.present()?)
 }
 
 /// Draws the outer loop's fixed-point residual per iteration (log scale, one
@@ -228,73 +214,65 @@ pub fn surface_plot(
     png: &Path,
 ) -> Result<(), ReportError> {
     register_font();
-    let draw =
-        |temporary: &Path| -> Result<(), String> {
-            let root = BitMapBackend::new(temporary, (800u32, 800u32)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| e.to_string())?;
-            let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-            );
-            let mut scale = 0.0f64;
-            for &(x, y, d) in points {
-                x_lo = x_lo.min(x);
-                x_hi = x_hi.max(x);
-                y_lo = y_lo.min(y);
-                y_hi = y_hi.max(y);
-                scale = scale.max(d.abs());
-            }
-            if !x_lo.is_finite() {
-                (x_lo, x_hi, y_lo, y_hi) = (-1.0, 1.0, -1.0, 1.0);
-            }
-            let pad = 0.05 * (x_hi - x_lo).max(y_hi - y_lo).max(1e-9);
-            let mut chart = ChartBuilder::on(&root)
-                .caption(title, ("sans-serif", 18))
-                .margin(15)
-                .x_label_area_size(40)
-                .y_label_area_size(50)
-                .build_cartesian_2d((x_lo - pad)..(x_hi + pad), (y_lo - pad)..(y_hi + pad))
-                .map_err(|e| e.to_string())?;
-            chart
-                .configure_mesh()
-                .x_desc(format!("x (m); colour: deviation, ±{scale:.2e} mm"))
-                .y_desc("y (m)")
-                .label_style(("sans-serif", 14))
-                .draw()
-                .map_err(|e| e.to_string())?;
-            let colour = |d: f64| {
-                let t = if scale > 0.0 {
-                    (d / scale).clamp(-1.0, 1.0)
-                } else {
-                    0.0
-                };
-                let fade = |v: f64| (255.0 * (1.0 - v.abs())) as u8;
-                if t >= 0.0 {
-                    RGBColor(255, fade(t), fade(t))
-                } else {
-                    RGBColor(fade(t), fade(t), 255)
-                }
+    let draw = |temporary: &Path| -> Result<(), DrawError> {
+        let root = BitMapBackend::new(temporary, (800u32, 800u32)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        let mut scale = 0.0f64;
+        for &(x, y, d) in points {
+            x_lo = x_lo.min(x);
+            x_hi = x_hi.max(x);
+            y_lo = y_lo.min(y);
+            y_hi = y_hi.max(y);
+            scale = scale.max(d.abs());
+        }
+        if !x_lo.is_finite() {
+            (x_lo, x_hi, y_lo, y_hi) = (-1.0, 1.0, -1.0, 1.0);
+        }
+        let pad = 0.05 * (x_hi - x_lo).max(y_hi - y_lo).max(1e-9);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d((x_lo - pad)..(x_hi + pad), (y_lo - pad)..(y_hi + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc(format!("x (m); colour: deviation, ±{scale:.2e} mm"))
+            .y_desc("y (m)")
+            .label_style(("sans-serif", 14))
+            .draw()?;
+        let colour = |d: f64| {
+            let t = if scale > 0.0 {
+                (d / scale).clamp(-1.0, 1.0)
+            } else {
+                0.0
             };
-            chart
-                .draw_series(points.iter().map(|&(x, y, d)| {
-                    Circle::new((x, y), 6, ShapeStyle::from(&colour(d)).filled())
-                }))
-                .map_err(|e| e.to_string())?;
-            chart
-                .draw_series(
-                    points
-                        .iter()
-                        .map(|&(x, y, _)| Circle::new((x, y), 6, BLACK.stroke_width(1))),
-                )
-                .map_err(|e| e.to_string())?;
-            root.present().map_err(|e| e.to_string())
+            let fade = |v: f64| (255.0 * (1.0 - v.abs())) as u8;
+            if t >= 0.0 {
+                RGBColor(255, fade(t), fade(t))
+            } else {
+                RGBColor(fade(t), fade(t), 255)
+            }
         };
-    write_atomic_with(png, draw).map_err(|message| ReportError::Plot {
-        path: png.to_path_buf(),
-        message,
-    })
+        chart.draw_series(
+            points
+                .iter()
+                .map(|&(x, y, d)| Circle::new((x, y), 6, ShapeStyle::from(&colour(d)).filled())),
+        )?;
+        chart.draw_series(
+            points
+                .iter()
+                .map(|&(x, y, _)| Circle::new((x, y), 6, BLACK.stroke_width(1))),
+        )?;
+        Ok(root.present()?)
+    };
+    write_atomic_with(png, draw)
 }
 
 /// Floor of a logarithmic ratio-error axis (the reference itself has 0).
@@ -345,7 +323,7 @@ fn draw_study_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     rows: &[StudyRow],
     panel: &StudyPanel<'_>,
-) -> Result<(), String>
+) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
 {
@@ -372,8 +350,7 @@ where
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())?;
     chart
         .configure_mesh()
         .x_desc("wall time of the design (s)")
@@ -381,8 +358,7 @@ where
         .y_desc(panel.y_desc)
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
 
     // The Pareto front among the designs of the reference's net (the
     // reference itself is the yardstick, not a contender).
@@ -400,19 +376,15 @@ where
         .filter_map(|(p, optimal)| optimal.then_some(*p))
         .collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));
-    chart
-        .draw_series(LineSeries::new(
-            front.clone(),
-            BLACK.mix(0.5).stroke_width(1),
-        ))
-        .map_err(|e| e.to_string())?;
-    chart
-        .draw_series(
-            front
-                .iter()
-                .map(|&p| Circle::new(p, 9, BLACK.stroke_width(2))),
-        )
-        .map_err(|e| e.to_string())?;
+    chart.draw_series(LineSeries::new(
+        front.clone(),
+        BLACK.mix(0.5).stroke_width(1),
+    ))?;
+    chart.draw_series(
+        front
+            .iter()
+            .map(|&p| Circle::new(p, 9, BLACK.stroke_width(2))),
+    )?;
     // Labels of nearby points are stacked downwards rather than overprinted.
     let mut placed: Vec<(i32, i32)> = Vec::new();
     let mut offsets = Vec::with_capacity(ok.len());
@@ -430,17 +402,15 @@ where
         }
         offsets.push(py - chart.backend_coord(&(r.time_s, y(r))).1);
     }
-    chart
-        .draw_series(ok.iter().zip(offsets).map(|((r, label), dy)| {
-            EmptyElement::at((r.time_s, y(r)))
-                + Circle::new((0, 0), 5, knob_colour(r.knob).filled())
-                + Text::new(
-                    label.as_deref().unwrap_or_default().to_string(),
-                    (7, dy),
-                    ("sans-serif", 12).into_font(),
-                )
-        }))
-        .map_err(|e| e.to_string())?;
+    chart.draw_series(ok.iter().zip(offsets).map(|((r, label), dy)| {
+        EmptyElement::at((r.time_s, y(r)))
+            + Circle::new((0, 0), 5, knob_colour(r.knob).filled())
+            + Text::new(
+                label.as_deref().unwrap_or_default().to_string(),
+                (7, dy),
+                ("sans-serif", 12).into_font(),
+            )
+    }))?;
     Ok(())
 }
 
@@ -448,7 +418,7 @@ where
 fn draw_study_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     rows: &[StudyRow],
-) -> Result<(), String>
+) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
 {
@@ -459,20 +429,16 @@ where
         if !rows.iter().any(|r| r.knob == knob) {
             continue;
         }
-        area.draw(&Circle::new((x, y), 5, knob_colour(knob).filled()))
-            .map_err(|e| e.to_string())?;
-        area.draw(&Text::new(knob.name(), (x + 10, y - 8), font.clone()))
-            .map_err(|e| e.to_string())?;
+        area.draw(&Circle::new((x, y), 5, knob_colour(knob).filled()))?;
+        area.draw(&Text::new(knob.name(), (x + 10, y - 8), font.clone()))?;
         x += 40 + 9 * knob.name().len() as i32;
     }
-    area.draw(&Circle::new((x, y), 8, BLACK.stroke_width(2)))
-        .map_err(|e| e.to_string())?;
+    area.draw(&Circle::new((x, y), 8, BLACK.stroke_width(2)))?;
     area.draw(&Text::new(
         "Pareto-optimal among the designs of the reference's net (the reference excluded)",
         (x + 14, y - 8),
         font,
-    ))
-    .map_err(|e| e.to_string())?;
+    ))?;
     Ok(())
 }
 
@@ -480,14 +446,12 @@ fn draw_study<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     rows: &[StudyRow],
     title: &str,
-) -> Result<(), String>
+) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let body = root
-        .titled(title, ("sans-serif", 22))
-        .map_err(|e| e.to_string())?;
+    root.fill(&WHITE)?;
+    let body = root.titled(title, ("sans-serif", 22))?;
     let height = body.dim_in_pixel().1 as i32;
     let (charts, legend) = body.split_vertically(height - 35);
     let panels = charts.split_evenly((1, 2));
@@ -504,7 +468,7 @@ where
     draw_study_panel(&panels[0], rows, &rms)?;
     draw_study_panel(&panels[1], rows, &ratio)?;
     draw_study_legend(&legend, rows)?;
-    root.present().map_err(|e| e.to_string())
+    Ok(root.present()?)
 }
 
 /// Draws the accuracy study as PNG and SVG, each written atomically: two

@@ -51,13 +51,13 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOu
             "front" => Table::Front(
                 m.rows
                     .iter()
-                    .map(|l| parse_front_row(l).map_err(&bad))
+                    .map(|l| parse_front_row(l).map_err(|e| bad(e.to_string())))
                     .collect::<Result<_, _>>()?,
             ),
             "study" => Table::Study(
                 m.rows
                     .iter()
-                    .map(|l| parse_study_row(l).map_err(&bad))
+                    .map(|l| parse_study_row(l).map_err(|e| bad(e.to_string())))
                     .collect::<Result<_, _>>()?,
             ),
             other => return Err(bad(format!("unknown command `{other}`")).into()),
