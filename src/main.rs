@@ -384,7 +384,25 @@ fn main() -> ExitCode {
                 if let Some(m) = &r.limit_margin {
                     say!("truss under the design's pull: {m}");
                 }
-                say!("time: {:.2} s", r.time_s);
+                let t = &r.timings;
+                say!(
+                    "time: {:.2} s — mesh {:.2}, loop {:.2} (uniformity {:.2}, truss {:.2}), \
+                     comparison loops {:.2}, margin {:.2}, verification {:.2}, conventional {:.2}, \
+                     writing {:.2}",
+                    t.total_s,
+                    t.mesh_s,
+                    t.truss_setup_s
+                        + t.uniformity_s.iter().sum::<f64>()
+                        + t.truss_s.iter().sum::<f64>()
+                        + t.loop_other_s,
+                    t.uniformity_s.iter().sum::<f64>(),
+                    t.truss_s.iter().sum::<f64>(),
+                    t.comparison_loops_s,
+                    t.margin_s,
+                    t.verification_s,
+                    t.conventional_s,
+                    t.writing_s
+                );
                 for w in &r.net.warnings {
                     say!("warning: {w}");
                 }

@@ -284,3 +284,55 @@ fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
     assert!(anderson < paper, "Anderson {anderson}, paper {paper}");
     assert!(anderson <= aitken, "Anderson {anderson}, Aitken {aitken}");
 }
+
+/// `design.json` says where the time went: one entry per stage, the loop's
+/// per iteration, adding up to the command's wall time within 5 %.
+#[test]
+fn the_timings_of_a_design_run_add_up_to_its_wall_time() {
+    let out = tempfile::tempdir().unwrap();
+    let settings = DesignSettings {
+        relaxations: vec![RelaxationKind::Anderson, RelaxationKind::Paper],
+        ..DesignSettings::default()
+    };
+    let clock = std::time::Instant::now();
+    let outcome = design(
+        &common::problem("small-hex.toml"),
+        &settings,
+        Some(out.path()),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    let wall = clock.elapsed().as_secs_f64();
+    let t = &outcome.report.timings;
+    assert_eq!(t.uniformity_s.len(), outcome.report.outer_iterations);
+    assert_eq!(t.truss_s.len(), outcome.report.outer_iterations);
+    let stages = [
+        t.read_s,
+        t.mesh_s,
+        t.truss_setup_s,
+        t.loop_other_s,
+        t.comparison_loops_s,
+        t.margin_s,
+        t.verification_s,
+        t.conventional_s,
+        t.writing_s,
+    ];
+    assert!(
+        stages
+            .iter()
+            .chain(&t.uniformity_s)
+            .chain(&t.truss_s)
+            .all(|s| *s >= 0.0),
+        "{t:?}"
+    );
+    assert!(t.comparison_loops_s > 0.0 && t.verification_s > 0.0 && t.writing_s > 0.0);
+    assert!(t.total_s <= wall, "{} s of {wall} s", t.total_s);
+    assert!(
+        (t.stages_s() - wall).abs() <= 0.05 * wall,
+        "stages {} s, wall {wall} s: {t:?}",
+        t.stages_s()
+    );
+    let written: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("design.json")).unwrap()).unwrap();
+    assert_eq!(written["timings"]["total_s"].as_f64(), Some(t.total_s));
+}

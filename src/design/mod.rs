@@ -35,7 +35,7 @@ pub use outer_loop::{
     design_loop, design_loop_with, IterationRecord, LoopOutcome, LoopSettings, LoopTermination,
     DIVERGENCE_FACTOR,
 };
-pub use pipeline::{design_margin, run, DesignReport, DesignRun, DesignSettings, LoopRun};
+pub use pipeline::{design_margin, run, DesignReport, DesignRun, DesignSettings, LoopRun, Timings};
 pub use relaxation::{
     aitken_factor, paper_step, Aitken, Anderson, Paper, Relaxation, RelaxationKind, Step,
 };

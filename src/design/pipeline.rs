@@ -72,6 +72,54 @@ pub struct LoopRun {
     pub error: Option<String>,
 }
 
+/// Where a design run's wall time goes, s: every stage once, so that the
+/// stages add up to `total_s` (up to the writing of `design.json` itself).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Timings {
+    /// Reading the scene (and the tables it names).
+    pub read_s: f64,
+    /// The effects, the mesh, the uniformity problem and the two-stage
+    /// design problem.
+    pub mesh_s: f64,
+    /// Building the design loop's truss oracle (frame, symbolic analysis).
+    pub truss_setup_s: f64,
+    /// The design loop's uniformity designs, one per outer iteration.
+    pub uniformity_s: Vec<f64>,
+    /// The design loop's truss responses, one per outer iteration.
+    pub truss_s: Vec<f64>,
+    /// The rest of the design loop (relaxation, bookkeeping).
+    pub loop_other_s: f64,
+    /// The other relaxations' loops, run for comparison.
+    pub comparison_loops_s: f64,
+    /// The truss's limit margin under the design's pull.
+    pub margin_s: f64,
+    /// The design cut to length and assembled.
+    pub verification_s: f64,
+    /// The conventional design (the loop's iteration 0) assembled.
+    pub conventional_s: f64,
+    /// Writing every file but `design.json`.
+    pub writing_s: f64,
+    /// Wall time from reading the scene to writing `design.json`.
+    pub total_s: f64,
+}
+
+impl Timings {
+    /// The sum of the stages, s (`total_s` less what no stage measured).
+    pub fn stages_s(&self) -> f64 {
+        self.read_s
+            + self.mesh_s
+            + self.truss_setup_s
+            + self.uniformity_s.iter().sum::<f64>()
+            + self.truss_s.iter().sum::<f64>()
+            + self.loop_other_s
+            + self.comparison_loops_s
+            + self.margin_s
+            + self.verification_s
+            + self.conventional_s
+            + self.writing_s
+    }
+}
+
 /// `design.json`: the outer loop's design, its verification by assembly, and
 /// the conventional (rigid-truss) design verified on the same truss.
 #[derive(Debug, Clone, Serialize)]
@@ -110,6 +158,9 @@ pub struct DesignReport {
     pub boundary_m: Vec<[f64; 3]>,
     /// The design: q, tensions, lengths, nodes, reactions, spreads.
     pub net: Design,
+    /// Where the wall time went (reading and writing are the command's:
+    /// zero when the library is called directly).
+    pub timings: Timings,
 }
 
 /// A design run: the report and what its files are drawn from.
@@ -139,8 +190,10 @@ pub fn run(
     observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
 ) -> Result<DesignRun, Error> {
     let clock = Instant::now();
+    let mut timings = Timings::default();
     let model = settings.truss.unwrap_or(scene.effects.truss);
     let scene_nets = SceneNets::new(scene)?;
+    timings.mesh_s = clock.elapsed().as_secs_f64();
     let (mesh, nets) = (&scene_nets.mesh, &scene_nets.nets);
     let solver = settings.solver.build(None);
     let relaxations = if settings.relaxations.is_empty() {
@@ -158,13 +211,27 @@ pub fn run(
             ..LoopSettings::default()
         };
         let mut history = Vec::new();
+        let loop_clock = Instant::now();
         let result =
             scene_nets.design_loop(scene, solver.as_ref(), model, &loop_settings, &mut |r| {
                 history.push(r.clone());
                 observe(relaxation, r)
             });
+        let loop_s = loop_clock.elapsed().as_secs_f64();
+        if outcome.is_some() {
+            timings.comparison_loops_s += loop_s;
+        }
         match result {
             Ok(result) => {
+                if outcome.is_none() {
+                    let design_s: Vec<f64> =
+                        result.history.iter().map(|r| r.design_time_s).collect();
+                    let truss_s: Vec<f64> = result.history.iter().map(|r| r.truss_time_s).collect();
+                    timings.truss_setup_s = loop_s - result.time_s;
+                    timings.loop_other_s =
+                        result.time_s - design_s.iter().sum::<f64>() - truss_s.iter().sum::<f64>();
+                    (timings.uniformity_s, timings.truss_s) = (design_s, truss_s);
+                }
                 runs.push(LoopRun {
                     relaxation,
                     termination: result.termination,
@@ -213,12 +280,17 @@ pub fn run(
     } else {
         AssemblyTruss::Rigid
     };
+    let stage = Instant::now();
     let limit_margin = match assembly {
         AssemblyTruss::Rigid => None,
         AssemblyTruss::Flexible => Some(design_margin(scene, mesh, effects, &outcome.design)?),
     };
+    timings.margin_s = stage.elapsed().as_secs_f64();
+    let stage = Instant::now();
     let network = outcome.problem.network().clone();
     let verification = verify(scene, mesh, effects, &network, &outcome.design, assembly)?;
+    timings.verification_s = stage.elapsed().as_secs_f64();
+    let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
     // undeformed attachment points.
     let conventional = match assembly {
@@ -232,6 +304,7 @@ pub fn run(
             AssemblyTruss::Flexible,
         )?),
     };
+    timings.conventional_s = stage.elapsed().as_secs_f64();
     let report = DesignReport {
         scene: scene.name.clone(),
         solver: solver.name().to_string(),
@@ -249,6 +322,7 @@ pub fn run(
         limit_margin,
         boundary_m: outcome.boundary_m.clone(),
         net: outcome.design,
+        timings,
     };
     Ok(DesignRun {
         report,

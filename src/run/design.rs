@@ -2,6 +2,7 @@
 //! files, each written atomically once everything is computed.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use super::default_output_dir;
 use crate::design::{DesignReport, DesignSettings, IterationRecord, RelaxationKind};
@@ -37,24 +38,38 @@ pub fn design(
     output_dir: Option<&Path>,
     observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
 ) -> Result<DesignOutcome, Error> {
+    let clock = Instant::now();
     let scene = Scene::read(scene_path)?;
-    let run = crate::design::run(&scene, settings, observe)?;
+    let read_s = clock.elapsed().as_secs_f64();
+    let mut run = crate::design::run(&scene, settings, observe)?;
+    run.report.timings.read_s = read_s;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
-    let written = write_design(&dir, &scene, &run.mesh, &run.network, &run.report)?;
+    let written = write_design(
+        &dir,
+        &scene,
+        &run.mesh,
+        &run.network,
+        &mut run.report,
+        clock,
+    )?;
     Ok(DesignOutcome {
         report: run.report,
         written,
     })
 }
 
-/// The files of `ringmesh design`, each written atomically.
+/// The files of `ringmesh design`, each written atomically, `design.json`
+/// last, with the time spent writing the others and the command's wall time
+/// since `clock` in its timings.
 fn write_design(
     dir: &Path,
     scene: &Scene,
     mesh: &ReflectorMesh,
     network: &Network,
-    report: &DesignReport,
+    report: &mut DesignReport,
+    clock: Instant,
 ) -> Result<Vec<PathBuf>, Error> {
+    let writing = Instant::now();
     let path = |name: &str| dir.join(name);
     let series: Vec<(String, Vec<(usize, f64)>)> = report
         .runs
@@ -103,6 +118,8 @@ fn write_design(
         &path("cables.csv"),
         cables_csv(network, &report.net, &scene.cables).as_bytes(),
     )?;
+    report.timings.writing_s = writing.elapsed().as_secs_f64();
+    report.timings.total_s = clock.elapsed().as_secs_f64();
     write_json(&path("design.json"), report)?;
     Ok([
         "design.json",
