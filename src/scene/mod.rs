@@ -167,8 +167,15 @@ pub struct FrontNet {
     pub rings: usize,
     /// Inward sag of the boundary at mid-bay, as a fraction of the bay chord.
     pub boundary_sag_ratio: f64,
-    /// Target mean tension of the front net's interior cables, N.
+    /// Target mean tension of the front net's interior cables, N: given, or
+    /// resolved from `membrane_stress_n_per_m` when the file gives that.
+    #[serde(default)]
     pub mean_tension_n: f64,
+    /// The membrane stress the net carries, N/m: the alternative to
+    /// `mean_tension_n` that keeps its meaning as the net is refined
+    /// ([`membrane_tension_n`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub membrane_stress_n_per_m: Option<f64>,
 }
 
 /// The rear net: the front net's plan grid on a paraboloid opening towards the
@@ -179,8 +186,14 @@ pub struct RearNet {
     /// Focal length of the rear paraboloid, m: its rise above the bottom hinges
     /// is `(R² − ρ²)/(4 F_rear)` at plan distance ρ from the aperture centre.
     pub focal_length_m: f64,
-    /// Target mean tension of the rear net's interior cables, N.
+    /// Target mean tension of the rear net's interior cables, N: given, or
+    /// resolved from `membrane_stress_n_per_m`.
+    #[serde(default)]
     pub mean_tension_n: f64,
+    /// The rear net's membrane stress, N/m (the alternative to
+    /// `mean_tension_n`, see [`membrane_tension_n`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub membrane_stress_n_per_m: Option<f64>,
 }
 
 /// Cable properties.
@@ -381,6 +394,7 @@ impl Scene {
         if scene.name.is_empty() {
             scene.name = default_name.to_string();
         }
+        scene.resolve_tensions();
         scene.validate()?;
         scene.read_effect_files(folder)?;
         Ok(scene)
@@ -475,9 +489,21 @@ impl Scene {
                 ),
             ));
         }
-        positive("front_net.mean_tension_n", f.mean_tension_n)?;
+        let tension = membrane_tension_n(self, 1.0);
+        one_tension_of(
+            "front_net",
+            f.mean_tension_n,
+            f.membrane_stress_n_per_m,
+            tension,
+        )?;
         positive("rear_net.focal_length_m", self.rear_net.focal_length_m)?;
-        positive("rear_net.mean_tension_n", self.rear_net.mean_tension_n)?;
+        let r = &self.rear_net;
+        one_tension_of(
+            "rear_net",
+            r.mean_tension_n,
+            r.membrane_stress_n_per_m,
+            tension,
+        )?;
 
         let u = &self.uniformity;
         if u.groups.is_empty() {
@@ -543,6 +569,26 @@ impl Scene {
         Ok(())
     }
 
+    /// Sets each net's mean tension from its membrane stress, where the file
+    /// gives that instead (`validate` then checks the pair).
+    fn resolve_tensions(&mut self) {
+        let per_unit_stress = membrane_tension_n(self, 1.0);
+        for (mean, stress) in [
+            (
+                &mut self.front_net.mean_tension_n,
+                self.front_net.membrane_stress_n_per_m,
+            ),
+            (
+                &mut self.rear_net.mean_tension_n,
+                self.rear_net.membrane_stress_n_per_m,
+            ),
+        ] {
+            if let (0.0, Some(n)) = (*mean, stress) {
+                *mean = n * per_unit_stress;
+            }
+        }
+    }
+
     /// The uniformity groups with their target mean tensions, N.
     pub fn uniformity_targets(&self) -> Vec<(crate::CableGroup, f64)> {
         self.uniformity
@@ -558,6 +604,70 @@ impl Scene {
     /// Radius of the aperture circle, m.
     pub fn aperture_radius_m(&self) -> f64 {
         0.5 * self.reflector.aperture_diameter_m
+    }
+}
+
+/// The uniform cable tension, N, at which the front net's interior cables
+/// carry the isotropic membrane stress `stress_n_per_m`, N/m, on the plan grid
+/// of the scene's sector subdivision (the rear net shares it).
+///
+/// A uniform-tension net in a homogeneous isotropic stress state `N` has
+/// `Σ_k T ℓ_k = tr(σ) A = 2 N A`, so `T = 2 N A / Σ_k ℓ_k` (on an equilateral
+/// grid of spacing `a` this is `T = N a/√3`, as the net is refined). `A` and
+/// `Σ ℓ` are those of the plan grid without the boundary sag, in closed form:
+/// `N` sectors of apex `θ = 2π/N`, radial edge `R` (the aperture radius),
+/// chord `c = 2R sin(θ/2)`, each subdivided into `r²` triangles, whose edges
+/// total `(r + 1)(2R + c)/2`; the interior cables leave out the boundary
+/// chords and count each radial edge once.
+pub fn membrane_tension_n(scene: &Scene, stress_n_per_m: f64) -> f64 {
+    let n = scene.truss.bays as f64;
+    let r = scene.front_net.rings as f64;
+    let radius = scene.aperture_radius_m();
+    let theta = std::f64::consts::TAU / n;
+    let chord = 2.0 * radius * (0.5 * theta).sin();
+    let area = n * 0.5 * radius * radius * theta.sin();
+    let interior = n * (0.5 * (r + 1.0) * (2.0 * radius + chord) - chord - radius);
+    2.0 * stress_n_per_m * area / interior
+}
+
+/// Exactly one of `<net>.mean_tension_n` and `<net>.membrane_stress_n_per_m`
+/// (a resolved scene has both, consistent: `tension_per_stress` N per N/m).
+fn one_tension_of(
+    net: &'static str,
+    mean_tension_n: f64,
+    stress: Option<f64>,
+    tension_per_stress: f64,
+) -> Result<(), SceneError> {
+    let (mean_key, stress_key) = match net {
+        "front_net" => (
+            "front_net.mean_tension_n",
+            "front_net.membrane_stress_n_per_m",
+        ),
+        _ => (
+            "rear_net.mean_tension_n",
+            "rear_net.membrane_stress_n_per_m",
+        ),
+    };
+    match stress {
+        None if mean_tension_n == 0.0 => Err(SceneError::invalid(
+            mean_key,
+            format!("missing: give `{mean_key}` (N) or `{stress_key}` (N/m)"),
+        )),
+        None => positive(mean_key, mean_tension_n),
+        Some(n) => {
+            positive(stress_key, n)?;
+            let resolved = n * tension_per_stress;
+            if (mean_tension_n - resolved).abs() > 1e-12 * resolved {
+                return Err(SceneError::invalid(
+                    stress_key,
+                    format!(
+                        "give either `{mean_key}` or `{stress_key}`, not both (the stress \
+                         means {resolved:.6} N)"
+                    ),
+                ));
+            }
+            Ok(())
+        }
     }
 }
 
