@@ -93,7 +93,10 @@ fn main() {
             eprintln!("{name}: {}", String::from_utf8_lossy(&output.stderr));
             continue;
         };
-        let v: Vec<f64> = line.split('\t').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
+        let v: Vec<f64> = line
+            .split('\t')
+            .map(|x| x.parse().unwrap_or(f64::NAN))
+            .collect();
         if v.len() != 12 {
             eprintln!("{name}: {line}");
             continue;
@@ -101,7 +104,18 @@ fn main() {
         println!(
             "| {name} | {} | {} | {:.2} s | {:.2} s | {:.2} s | {:.2} s | {:.2} s | {:.2} s | \
              {:.2} s | {:.2} s | {:.1} s | {:.2} GB |",
-            v[0], v[10], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[1], v[11] / 1e9
+            v[0],
+            v[10],
+            v[2],
+            v[3],
+            v[4],
+            v[5],
+            v[6],
+            v[7],
+            v[8],
+            v[9],
+            v[1],
+            v[11] / 1e9
         );
         sizes.push((v[0], v[1], v[11]));
     }

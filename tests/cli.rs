@@ -362,3 +362,56 @@ fn front_writes_csv_and_plots() {
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
+
+/// The README's main command (run with the built binary) in a fresh clone of
+/// the repository leaves `git status` clean: its outputs go where git
+/// ignores them.
+#[test]
+fn the_readme_main_command_leaves_a_clean_checkout() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let command = readme
+        .lines()
+        .map(str::trim)
+        .find_map(|l| l.strip_prefix("cargo run --release -- design "))
+        .expect("README names the main command");
+    let args: Vec<&str> = std::iter::once("design")
+        .chain(command.split_whitespace())
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let clone = dir.path().join("clone");
+    let git = |args: &[&str], cwd: &std::path::Path| {
+        std::process::Command::new("git")
+            .args(args)
+            .current_dir(cwd)
+            .output()
+            .expect("git runs")
+    };
+    let cloned = git(
+        &[
+            "clone",
+            "--quiet",
+            "--local",
+            &root.display().to_string(),
+            "clone",
+        ],
+        dir.path(),
+    );
+    if !cloned.status.success() {
+        // Not a git checkout (a source tarball): nothing to keep clean.
+        return;
+    }
+    let out = common::ringmesh_in(&args, &clone);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let status = git(&["status", "--porcelain"], &clone);
+    assert!(status.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&status.stdout),
+        "",
+        "git status after {args:?}"
+    );
+}
