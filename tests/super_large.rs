@@ -118,4 +118,14 @@ fn super_60m_designs_assembles_and_keeps_its_margin() {
     );
     let margin = r.limit_margin.as_ref().unwrap();
     assert!(margin.stable_to >= 2.0, "{margin:?}");
+    // The net carries the membrane stress the scene asks for: the front
+    // net's mean tension is the one it resolves to.
+    let scene = Scene::read(&path).unwrap();
+    let front = &r.net.sets[0];
+    let target = scene.front_net.mean_tension_n;
+    assert!(
+        (front.mean_tension_n / target - 1.0).abs() <= 1e-9,
+        "{} N for {target} N",
+        front.mean_tension_n
+    );
 }

@@ -9,12 +9,13 @@
 //!
 //! ```text
 //! min ½ Σ_sets Σ_k (ℓ_k q_k − T̄_s)² + ½ δ Σ_others (ℓ_k q_k)²
-//! s.t. A q = p,  t_s ≤ ℓ_k q_k ≤ r_s t_s (k in set s),
+//! s.t. A q = p,  mean_k∈s₁ ℓ_k q_k = T̄_s₁,  t_s ≤ ℓ_k q_k ≤ r_s t_s (k in set s),
 //!      ℓ_k q_k ≥ τ (others),  0 < q ≤ [q],
 //! ```
 //!
 //! strictly convex in the tensions, hence unique, and continuous in the
-//! geometry for `r_s` above the optimal ratio (clarabel, one QP).
+//! geometry for `r_s` above the optimal ratio (clarabel, one QP). The first
+//! set's mean tension is held at its target, as the ratio solvers hold it.
 
 use std::time::Instant;
 
@@ -53,6 +54,16 @@ pub fn most_uniform(
     let n_sets = problem.sets().len();
     let mut program = ConicProgram::new(m + n_sets);
     program.equilibrium(problem, 0.0);
+    // Pretension level, as the ratio solvers hold it: the first set's mean
+    // tension at its target. Without it the objective pulls the level below
+    // the target by `(mean T)²/mean(T²)` — half of it at a ratio of 16.
+    let first = &problem.sets()[0];
+    let mean_row: Vec<(usize, f64)> = first
+        .edges
+        .iter()
+        .map(|&k| (k, lengths[k] / first.edges.len() as f64))
+        .collect();
+    program.row(Cone::Zero, &mean_row, first.mean_tension_n);
     let mut p = vec![0.0; m];
     let mut c = vec![0.0; m + n_sets];
     for (s, (set, &r)) in problem.sets().iter().zip(ratio_bounds).enumerate() {
