@@ -336,3 +336,48 @@ fn the_timings_of_a_design_run_add_up_to_its_wall_time() {
         serde_json::from_slice(&std::fs::read(out.path().join("design.json")).unwrap()).unwrap();
     assert_eq!(written["timings"]["total_s"].as_f64(), Some(t.total_s));
 }
+
+/// The outer loop needs the net's pull to be a function of the boundary: a
+/// ratio solver's optimum is a face, and the design the loop takes from it
+/// must move with the boundary continuously — the pull's change is linear in
+/// a boundary move from 1e-8 to 1e-4 m.
+#[test]
+fn the_pull_of_the_design_moves_linearly_with_the_boundary() {
+    for name in ["small-hex", "realistic-26m"] {
+        let scene = common::scene(name);
+        let (mesh, problem) = scene_problem(&scene).unwrap();
+        let nets = TiedNets::new(&mesh, problem).unwrap();
+        let solver = SolverKind::Lp.build(None);
+        let c0 = layout_points(&mesh.truss);
+        let pull0 = nets.design(solver.as_ref(), &c0).unwrap().design.pull_n();
+        let slopes: Vec<f64> = [1e-8, 1e-7, 1e-6, 1e-5, 1e-4]
+            .iter()
+            .map(|&h| {
+                // Every top hinge moves radially inward by h.
+                let n = mesh.truss.bays();
+                let moved: Vec<[f64; 3]> = c0
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| {
+                        let r = p[0].hypot(p[1]);
+                        let s = if i < n { 1.0 - h / r } else { 1.0 };
+                        [p[0] * s, p[1] * s, p[2]]
+                    })
+                    .collect();
+                let pull = nets
+                    .design(solver.as_ref(), &moved)
+                    .unwrap()
+                    .design
+                    .pull_n();
+                common::max_abs_diff(&pull, &pull0) / h
+            })
+            .collect();
+        let (lo, hi) = slopes.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| {
+            (lo.min(s), hi.max(s))
+        });
+        assert!(
+            hi <= 1.5 * lo,
+            "{name}: dpull/dC over h = 1e-8…1e-4: {slopes:?}"
+        );
+    }
+}
