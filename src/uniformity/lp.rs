@@ -171,7 +171,7 @@ fn solve_plan(
     problem: &UniformityProblem,
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<f64>, usize), PlanFallback> {
-    let solution = ipm::solve(plan.lp(), &IpmSettings::default())?;
+    let solution = ipm::solve(plan.lp(), &IpmSettings::plan())?;
     let [primal, dual, gap] = solution.residuals;
     match solution.status {
         IpmStatus::Converged => {}
