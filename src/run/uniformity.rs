@@ -9,7 +9,8 @@ use crate::algebra::norm3;
 use crate::network::Network;
 use crate::report::write_json;
 use crate::uniformity::{
-    Route, SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem, UniformitySet,
+    Route, SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem,
+    UniformitySet,
 };
 use crate::Error;
 

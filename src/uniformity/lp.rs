@@ -297,7 +297,10 @@ mod tests {
             .count();
         assert_eq!(plan.lp().n_free, ties, "one plan node per tie");
         assert_eq!(plan.n_ties(), ties);
-        assert!(plan.has_rear(), "the scene's rear net mirrors its front net");
+        assert!(
+            plan.has_rear(),
+            "the scene's rear net mirrors its front net"
+        );
         let (q_plan, _) = solve_plan(&plan, &problem, &mut Vec::new()).expect("plan");
         let q_full = solve_full(&problem, &mut Vec::new())
             .expect("full")

@@ -525,8 +525,11 @@ fn rear_mirror(
                     let o = other_end(c, f);
                     !free(o)
                         && !net_node[r_fixed]
-                        && norm3([x[o][0] - x[f][0] - want[0], x[o][1] - x[f][1] - want[1], 0.0])
-                            <= tolerance
+                        && norm3([
+                            x[o][0] - x[f][0] - want[0],
+                            x[o][1] - x[f][1] - want[1],
+                            0.0,
+                        ]) <= tolerance
                 })
             }
             (false, false) => None,
