@@ -8,10 +8,18 @@
 //! * `lp_nodes` — the `lp` optimum of the paper scene (30 bays) with its front net
 //!   refined to ~10³, 10⁴ and 3·10⁴ net nodes (the id is the node count, front +
 //!   rear); `RINGMESH_BENCH_RINGS=57` adds a ~10⁵-node net;
+//! * `lp_independent` — the `lp` optimum of independently generated tied nets
+//!   (`tests/common/hexnet.rs`: hexagonal grid on a 100 m aperture, shuffled
+//!   nodes and cables, every free node on its own anchor) of ~10³ and ~10⁴
+//!   free nodes (the id is the free node count); `RINGMESH_BENCH_FREE=100000`
+//!   adds a ~10⁵-node net (≈ 20 s a solve);
 //! * `gradient_nodes` — the `gradient` solver on the paper scene with 3 rings
 //!   (362 net nodes).
 //!
 //! Run with `cargo bench --bench uniformity`.
+
+#[path = "../tests/common/hexnet.rs"]
+mod hexnet;
 
 use std::path::Path;
 use std::time::Duration;
@@ -19,7 +27,8 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use ringmesh::design::scene_problem;
 use ringmesh::uniformity::{
-    Bisection, Gradient, Lp, SolverKind, UniformityProblem, UniformitySolver,
+    Bisection, Gradient, Lp, SolverKind, SurfaceTarget, UniformityProblem, UniformitySet,
+    UniformitySolver,
 };
 use ringmesh::Scene;
 
@@ -109,6 +118,47 @@ fn lp_nodes(c: &mut Criterion) {
     group.finish();
 }
 
+/// The `lp` problem of a generated tied net of about `free` free nodes: every
+/// cable but the hangers in the set.
+fn independent_problem(free: usize) -> UniformityProblem {
+    let network = hexnet::HexNet::with_free_nodes(free, 100.0).build();
+    let edges = (0..network.n_edges())
+        .filter(|&k| network.group_of(k) != "hangers")
+        .collect();
+    let fixed = network.fixed_mask();
+    let surface = (0..network.n_nodes()).filter(|&i| !fixed[i]).collect();
+    let set = UniformitySet {
+        name: "surface+rim".into(),
+        edges,
+        mean_tension_n: 50.0,
+    };
+    UniformityProblem::new(network, vec![set], surface, SurfaceTarget::Prescribed, 1e9)
+        .expect("a generated net")
+}
+
+fn lp_independent(c: &mut Criterion) {
+    let mut sizes = vec![1_000, 10_000];
+    if let Ok(extra) = std::env::var("RINGMESH_BENCH_FREE") {
+        sizes.extend(
+            extra
+                .split(',')
+                .filter_map(|r| r.trim().parse::<usize>().ok()),
+        );
+    }
+    let mut group = c.benchmark_group("lp_independent");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    for free in sizes {
+        let p = independent_problem(free);
+        let free = p.structure().free_nodes().len();
+        group.bench_with_input(BenchmarkId::from_parameter(free), &p, |b, p| {
+            b.iter(|| Lp.solve(p))
+        });
+    }
+    group.finish();
+}
+
 fn gradient_nodes(c: &mut Criterion) {
     let p = problem("paper-26m", Some(3));
     let mut group = c.benchmark_group("gradient_nodes");
@@ -126,6 +176,7 @@ criterion_group!(
     solvers,
     bisection_tolerance,
     lp_nodes,
+    lp_independent,
     gradient_nodes
 );
 criterion_main!(benches);

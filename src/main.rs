@@ -435,6 +435,9 @@ fn main() -> ExitCode {
                 d.iterations,
                 d.time_s
             );
+            if let Some(route) = d.route {
+                say!("route: {route}");
+            }
             for w in &d.warnings {
                 say!("warning: {w}");
             }
@@ -466,6 +469,12 @@ fn main() -> ExitCode {
                 o.iterations,
                 o.time_s
             );
+            if let Some(route) = o.route {
+                say!("route: {route}");
+            }
+            for w in &o.warnings {
+                say!("warning: {w}");
+            }
             say!("wrote {}", output.display());
         }),
         Command::Front {

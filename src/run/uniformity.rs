@@ -9,7 +9,8 @@ use crate::algebra::norm3;
 use crate::network::Network;
 use crate::report::write_json;
 use crate::uniformity::{
-    SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem, UniformitySet,
+    Route, SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem,
+    UniformitySet,
 };
 use crate::Error;
 
@@ -32,6 +33,12 @@ pub struct UniformityOutput {
     pub iterations: usize,
     /// Wall time, s.
     pub time_s: f64,
+    /// How the solver got there, when it has several routes (`lp`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub route: Option<Route>,
+    /// Everything the solver reported other than plain success (a fallback
+    /// and its reason among them).
+    pub warnings: Vec<String>,
 }
 
 /// `ringmesh uniformity`: the uniformity problem on a network whose node
@@ -112,6 +119,8 @@ pub fn uniformity(
         termination: design.termination,
         iterations: design.iterations,
         time_s: design.time_s,
+        route: design.route,
+        warnings: design.warnings,
     };
     write_json(output_path, &output)?;
     Ok(output)

@@ -111,7 +111,18 @@ impl ConicProgram {
     /// Solves `min ½ xᵀ diag(p) x + cᵀx` subject to the rows; `p` may be
     /// shorter than `x` (the rest of the diagonal is zero). Retries as
     /// [`Self::solve`].
-    pub(crate) fn solve_quadratic(mut self, p_diagonal: &[f64], c: &[f64]) -> ConicOutcome {
+    pub(crate) fn solve_quadratic(self, p_diagonal: &[f64], c: &[f64]) -> ConicOutcome {
+        self.solve_with(p_diagonal, c, &ATTEMPTS)
+    }
+
+    /// [`Self::solve_quadratic`] with the LDLᵀ backends and static
+    /// regularisations of `attempts`, in order (see [`ATTEMPTS`]).
+    pub(crate) fn solve_with(
+        mut self,
+        p_diagonal: &[f64],
+        c: &[f64],
+        attempts: &[(&str, f64)],
+    ) -> ConicOutcome {
         self.close();
         let n_rows = self.b.len();
         let a = CscMatrix::new_from_triplets(n_rows, self.n_vars, self.rows, self.cols, self.vals);
@@ -124,7 +135,7 @@ impl ConicProgram {
             p_diagonal.to_vec(),
         );
         let mut outcome = None;
-        for (attempt, (method, regularisation)) in ATTEMPTS.iter().enumerate() {
+        for (attempt, (method, regularisation)) in attempts.iter().enumerate() {
             let settings = DefaultSettingsBuilder::default()
                 .verbose(false)
                 .direct_solve_method(method.to_string())
@@ -168,7 +179,7 @@ impl ConicProgram {
 }
 
 /// clarabel's LDLᵀ backend and static regularisation, in the order tried.
-const ATTEMPTS: [(&str, f64); 2] = [("faer", 1e-7), ("qdldl", 1e-6)];
+pub(crate) const ATTEMPTS: [(&str, f64); 2] = [("faer", 1e-7), ("qdldl", 1e-6)];
 
 /// What a conic solve says, in the terms the solvers act on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

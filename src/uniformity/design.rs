@@ -28,6 +28,33 @@ pub enum Termination {
     NumericalError,
 }
 
+/// How the `lp` solver reached its design (reported with the design; every
+/// route but the first also leaves its reason in the warnings).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Route {
+    /// The plan problem of a tied net (two rows per free net node) by the
+    /// structured interior-point method, completed with the ties (and a rear
+    /// net).
+    PlanInteriorPoint,
+    /// The plan problem by clarabel (QDLDL), after the interior-point method
+    /// stopped short, completed the same way.
+    PlanClarabel,
+    /// The full three-dimensional LP by clarabel: the network is not a tied
+    /// net, or the plan optimum does not complete.
+    FullClarabel,
+}
+
+impl fmt::Display for Route {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Route::PlanInteriorPoint => "plan LP, interior point",
+            Route::PlanClarabel => "plan LP, clarabel (fallback)",
+            Route::FullClarabel => "full 3-D LP, clarabel",
+        })
+    }
+}
+
 /// The free nodes whose cables are slack in every equilibrium of the
 /// prescribed geometry: why it has no strictly positive force densities.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
@@ -127,6 +154,9 @@ pub struct Design {
     pub time_s: f64,
     /// Everything the inner solvers reported other than plain success.
     pub warnings: Vec<String>,
+    /// How the solver got there, when it has several routes (`lp`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub route: Option<Route>,
     /// When the prescribed geometry has no strictly positive force densities:
     /// the nodes whose cables can only be slack (also in `warnings`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -214,6 +244,7 @@ impl Design {
             iterations,
             time_s: elapsed.as_secs_f64(),
             warnings,
+            route: None,
             slack_nodes: None,
         })
     }

@@ -21,7 +21,7 @@ mod problem;
 mod selection;
 
 pub use bisection::Bisection;
-pub use design::{Design, SlackNodes, TensionSpread, Termination};
+pub use design::{Design, Route, SlackNodes, TensionSpread, Termination};
 pub use front::{
     design_front, design_front_points, front_jobs, knob_values, FrontPoint, KnobRange,
 };

@@ -77,6 +77,28 @@ impl Default for IpmSettings {
 }
 
 impl IpmSettings {
+    /// The settings of the plan problem of a tied net (`D = 2`, see
+    /// `uniformity/plan.rs`): a static shift of 1e-12 of the unit diagonal and
+    /// no dropped pivots. The plan equilibrium matrix of a triangulated net has
+    /// independent rows, so a tiny pivot is never a mechanism: it is a
+    /// direction that the optimum's degenerate face leaves to the border `a`
+    /// (the cables at `Tmax` moving with `s`). Dropping it (a pivot replaced by
+    /// [`Self::pivot_delta`], right for the mechanisms of the 3-D problem)
+    /// loses exactly the direction `ds` depends on: measured on independent
+    /// hexagonal nets, the reduction's residual reached 10¹⁰…10⁹¹ of its
+    /// right-hand side near the optimum, FGMRES could not recover, and the
+    /// method stalled (2·10³ nodes), failed to factor (2·10⁴) or gave up
+    /// (2·10⁵). With the shift the border's elimination stays consistent and
+    /// the method converges on all of them (shift 1e-10 already leaves too
+    /// many directions damped at 2·10⁵ nodes for FGMRES to restore).
+    pub(crate) fn plan() -> Self {
+        IpmSettings {
+            regularization: 1e-12,
+            pivot_epsilon: 1e-30,
+            ..IpmSettings::default()
+        }
+    }
+
     /// Checks every setting's range: the tolerances, the pivot threshold and
     /// the shifts in `(0, 1)`, the shift bound at least the first shift, a
     /// growth above 1, a replacement pivot above 1, and at least one stall
