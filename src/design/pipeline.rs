@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::outer_loop::{IterationRecord, LoopSettings, LoopTermination};
+use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings, LoopTermination};
 use super::relaxation::RelaxationKind;
 use super::scene_nets::SceneNets;
 use super::DesignError;
@@ -104,6 +104,17 @@ pub struct Timings {
 }
 
 impl Timings {
+    /// The design loop's stages from its outcome and `loop_s`, its wall time
+    /// with the oracle's construction.
+    fn design_loop(&mut self, loop_s: f64, outcome: &LoopOutcome) {
+        self.uniformity_s = outcome.history.iter().map(|r| r.design_time_s).collect();
+        self.truss_s = outcome.history.iter().map(|r| r.truss_time_s).collect();
+        self.truss_setup_s = loop_s - outcome.time_s;
+        self.loop_other_s = outcome.time_s
+            - self.uniformity_s.iter().sum::<f64>()
+            - self.truss_s.iter().sum::<f64>();
+    }
+
     /// The sum of the stages, s (`total_s` less what no stage measured).
     pub fn stages_s(&self) -> f64 {
         self.read_s
@@ -224,13 +235,7 @@ pub fn run(
         match result {
             Ok(result) => {
                 if outcome.is_none() {
-                    let design_s: Vec<f64> =
-                        result.history.iter().map(|r| r.design_time_s).collect();
-                    let truss_s: Vec<f64> = result.history.iter().map(|r| r.truss_time_s).collect();
-                    timings.truss_setup_s = loop_s - result.time_s;
-                    timings.loop_other_s =
-                        result.time_s - design_s.iter().sum::<f64>() - truss_s.iter().sum::<f64>();
-                    (timings.uniformity_s, timings.truss_s) = (design_s, truss_s);
+                    timings.design_loop(loop_s, &result);
                 }
                 runs.push(LoopRun {
                     relaxation,

@@ -64,14 +64,7 @@ impl Bisection {
         let fraction = problem.min_tension_fraction;
         let mut program = ConicProgram::new(m + sets.len() + 1);
         program.equilibrium(problem, self.epsilon_n);
-        // Pretension level: mean tension of the first set at its target.
-        let first = &sets[0];
-        let mean_row: Vec<(usize, f64)> = first
-            .edges
-            .iter()
-            .map(|&k| (k, lengths[k] / first.edges.len() as f64))
-            .collect();
-        program.row(Cone::Zero, &mean_row, first.mean_tension_n);
+        program.first_set_mean_tension(problem);
         for (g, set) in sets.iter().enumerate() {
             for &k in &set.edges {
                 program.row(Cone::Nonnegative, &[(k, -lengths[k]), (level(g), 1.0)], 0.0);
@@ -91,7 +84,7 @@ impl Bisection {
                 program.row(
                     Cone::Nonnegative,
                     &[(level(0), -1.0)],
-                    -fraction * first.mean_tension_n,
+                    -fraction * sets[0].mean_tension_n,
                 );
             }
         }

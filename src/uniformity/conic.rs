@@ -38,6 +38,19 @@ impl ConicProgram {
         }
     }
 
+    /// The pretension level the ratio programs hold: the first set's mean
+    /// tension `Σ_k ℓ_k q_k / n` at its target (one zero-cone row).
+    pub(crate) fn first_set_mean_tension(&mut self, problem: &UniformityProblem) {
+        let lengths = problem.lengths_m();
+        let first = &problem.sets()[0];
+        let row: Vec<(usize, f64)> = first
+            .edges
+            .iter()
+            .map(|&k| (k, lengths[k] / first.edges.len() as f64))
+            .collect();
+        self.row(Cone::Zero, &row, first.mean_tension_n);
+    }
+
     /// Appends one row `b − a·x` to a cone of `kind` (merging consecutive rows of
     /// the same kind into one cone).
     pub(crate) fn row(&mut self, kind: Cone, entries: &[(usize, f64)], b: f64) {

@@ -54,16 +54,10 @@ pub fn most_uniform(
     let n_sets = problem.sets().len();
     let mut program = ConicProgram::new(m + n_sets);
     program.equilibrium(problem, 0.0);
-    // Pretension level, as the ratio solvers hold it: the first set's mean
-    // tension at its target. Without it the objective pulls the level below
-    // the target by `(mean T)²/mean(T²)` — half of it at a ratio of 16.
-    let first = &problem.sets()[0];
-    let mean_row: Vec<(usize, f64)> = first
-        .edges
-        .iter()
-        .map(|&k| (k, lengths[k] / first.edges.len() as f64))
-        .collect();
-    program.row(Cone::Zero, &mean_row, first.mean_tension_n);
+    // Pretension level, as the ratio solvers hold it. Without it the
+    // objective pulls the level below the target by `(mean T)²/mean(T²)` —
+    // half of it at a ratio of 16.
+    program.first_set_mean_tension(problem);
     let mut p = vec![0.0; m];
     let mut c = vec![0.0; m + n_sets];
     for (s, (set, &r)) in problem.sets().iter().zip(ratio_bounds).enumerate() {
