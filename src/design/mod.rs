@@ -3,7 +3,8 @@
 //! `M_{k+1} = G(C_k)`, relax, repeat until the boundary the net was designed
 //! for is the boundary the truss takes under that net.
 //!
-//! Any [`UniformitySolver`] and any [`TrussOracle`] plug in. The stopping test
+//! Any [`UniformitySolver`](crate::uniformity::UniformitySolver) and any
+//! [`TrussOracle`](crate::truss::TrussOracle) plug in. The stopping test
 //! is the true fixed-point residual `‖G(C_k) − C_k‖∞ ≤ tol` (largest distance
 //! of an attachment point from where the design assumed it). Each design is
 //! the two-stage design of [`TiedNets`]: the front net on the paraboloid, the

@@ -206,7 +206,7 @@ pub struct Cables {
     pub youngs_modulus_pa: f64,
     /// Density of the cable material, kg/m³.
     pub density_kg_per_m3: f64,
-    /// Upper bound [q] on any force density, N/m (paper eq. 5).
+    /// Upper bound `[q]` on any force density, N/m (paper eq. 5).
     pub max_force_density_n_per_m: f64,
 }
 
