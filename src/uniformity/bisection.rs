@@ -165,10 +165,6 @@ impl UniformitySolver for Bisection {
         false
     }
 
-    fn knob(&self) -> Option<f64> {
-        Some(self.epsilon_n)
-    }
-
     /// ε = 0 (exact equilibrium), then ε from 1e-3·T̄ to T̄ (N), `T̄` the
     /// first set's target mean tension.
     fn knob_range(&self, problem: &UniformityProblem) -> Option<KnobRange> {

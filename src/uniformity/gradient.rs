@@ -387,10 +387,6 @@ impl UniformitySolver for Gradient {
         "gradient"
     }
 
-    fn knob(&self) -> Option<f64> {
-        Some(self.weight)
-    }
-
     /// The ratio weight from 1e-8 to 1: the surface term is normalised, so
     /// 1e-6 is already near the exact-equilibrium design.
     fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {

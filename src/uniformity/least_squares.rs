@@ -180,10 +180,6 @@ impl UniformitySolver for LeastSquares {
         SOLVER
     }
 
-    fn knob(&self) -> Option<f64> {
-        self.lambda
-    }
-
     /// λ from 1e-6 to 1e2 (the equality-constrained limit λ → 0 is the
     /// `lp`-like exact point, run separately).
     fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {

@@ -129,10 +129,6 @@ impl UniformityError {
 pub trait UniformitySolver: Send + Sync {
     /// The name used on the command line and in reports.
     fn name(&self) -> &'static str;
-    /// The accuracy knob's value (ε, weight, λ), if the solver has one.
-    fn knob(&self) -> Option<f64> {
-        None
-    }
     /// The knob's name and the range the design front sweeps for `problem`
     /// (see [`knob_values`]), or `None` for a solver without a knob (one
     /// point).
