@@ -9,7 +9,7 @@ use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKin
 use ringmesh::effects::SceneEffects;
 use ringmesh::geometry::ReflectorMesh;
 use ringmesh::scene::{Scene, TrussModel};
-use ringmesh::truss::{layout_points, oracle};
+use ringmesh::truss::layout_points;
 use ringmesh::uniformity::{Design, SolverKind};
 use ringmesh::verify::{verify, AssemblyTruss, CableModel, Verification, INEXTENSIBLE_STIFFENING};
 use ringmesh::Network;
@@ -112,13 +112,7 @@ fn inextensible_rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
 fn the_design_for_the_deforming_truss_survives_inextensible_assembly() {
     let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
-    let mut truss = oracle(
-        TrussModel::Exact,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut truss = common::scene_oracle(TrussModel::Exact, &scene, &mesh);
     let settings = LoopSettings {
         relaxation: RelaxationKind::Anderson,
         tolerance_m: 1e-7,

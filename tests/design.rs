@@ -8,9 +8,7 @@ use ringmesh::design::{scene_problem, DesignSettings};
 use ringmesh::effects::SceneEffects;
 use ringmesh::run::design;
 use ringmesh::scene::{Scene, TrussModel};
-use ringmesh::truss::{
-    layout_points, limit_margin, oracle, RingTruss, MARGIN_PRECISION, MARGIN_SEARCH_TO,
-};
+use ringmesh::truss::{layout_points, limit_margin, RingTruss, MARGIN_PRECISION, MARGIN_SEARCH_TO};
 use ringmesh::uniformity::SolverKind;
 use ringmesh::verify::{verify, AssemblyTruss};
 
@@ -30,13 +28,7 @@ fn settings(relaxation: RelaxationKind) -> LoopSettings {
 fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
     let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
-    let mut truss = oracle(
-        TrussModel::Exact,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut truss = common::scene_oracle(TrussModel::Exact, &scene, &mesh);
     let outcome = design_loop(
         &nets,
         solver.as_ref(),
@@ -187,13 +179,7 @@ fn rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
 #[test]
 fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
     let (scene, mesh, nets) = common::small_hex_nets();
-    let mut truss = oracle(
-        TrussModel::Exact,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut truss = common::scene_oracle(TrussModel::Exact, &scene, &mesh);
     for kind in [SolverKind::Lp, SolverKind::LeastSquares] {
         let solver = kind.build(None);
         let c0 = layout_points(&mesh.truss);
@@ -222,13 +208,7 @@ fn designs_for_a_deformed_boundary_balance_and_keep_the_surface() {
 fn rigid_truss_loop_stops_after_one_design() {
     let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
-    let mut truss = oracle(
-        TrussModel::Rigid,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut truss = common::scene_oracle(TrussModel::Rigid, &scene, &mesh);
     for relaxation in [
         RelaxationKind::Paper,
         RelaxationKind::Aitken,
@@ -255,13 +235,7 @@ fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
     let (scene, mesh, nets) = common::small_hex_nets();
     let solver = SolverKind::Lp.build(None);
     let iterations = |relaxation| {
-        let mut truss = oracle(
-            TrussModel::Exact,
-            &scene,
-            &mesh.truss,
-            &SceneEffects::of(&scene),
-        )
-        .unwrap();
+        let mut truss = common::scene_oracle(TrussModel::Exact, &scene, &mesh);
         let outcome = design_loop(
             &nets,
             solver.as_ref(),

@@ -24,7 +24,7 @@ use ringmesh::mechanics::{
 };
 use ringmesh::network::{Network, NetworkError};
 use ringmesh::scene::TrussModel;
-use ringmesh::truss::{self, layout_points, RingTruss, TrussError};
+use ringmesh::truss::{layout_points, RingTruss, TrussError};
 use ringmesh::uniformity::{
     Design, SolverKind, SurfaceTarget, UniformityError, UniformityProblem, UniformitySet,
 };
@@ -501,8 +501,7 @@ fn ring_truss_past_its_limit_load_is_followed_or_reported() {
     assert!((5.5..7.5).contains(&limit), "limit {limit} × the pull");
 
     // The oracle the design loop queries says so, with the number.
-    let mut exact =
-        truss::oracle(TrussModel::Exact, &s, &mesh.truss, &SceneEffects::of(&s)).unwrap();
+    let mut exact = common::scene_oracle(TrussModel::Exact, &s, &mesh);
     let error = exact.respond(&pull).unwrap_err();
     let TrussError::NoEquilibrium {
         termination: StaticTermination::LimitPoint { .. },

@@ -11,7 +11,7 @@ use ringmesh::effects::SceneEffects;
 use ringmesh::geometry::build_mesh;
 use ringmesh::mechanics::Section;
 use ringmesh::scene::{Scene, SceneError, TrussModel};
-use ringmesh::truss::{self, RingTruss, RodKind, RodProperties, TrussRod};
+use ringmesh::truss::{RingTruss, RodKind, RodProperties, TrussRod};
 
 fn small_hex() -> Scene {
     let path = common::problem("small-hex.toml");
@@ -57,7 +57,7 @@ fn scaled_table(scene: &Scene, kinds: &[RodKind], factors: [f64; 4]) -> String {
 /// Attachment displacements, m: 2N × 3.
 fn displacements(scene: &Scene, model: TrussModel, loads: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let mesh = build_mesh(scene).unwrap();
-    let mut oracle = truss::oracle(model, scene, &mesh.truss, &SceneEffects::of(scene)).unwrap();
+    let mut oracle = common::scene_oracle(model, scene, &mesh);
     let moved = oracle.respond(loads).unwrap().positions_m;
     moved
         .iter()

@@ -102,20 +102,8 @@ fn linear_and_exact_trusses_agree_under_tiny_loads_and_part_under_the_papers() {
         .chain(&mesh.truss.bottom_m)
         .copied()
         .collect();
-    let mut linear = truss::oracle(
-        TrussModel::Linear,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
-    let mut exact = truss::oracle(
-        TrussModel::Exact,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut linear = common::scene_oracle(TrussModel::Linear, &scene, &mesh);
+    let mut exact = common::scene_oracle(TrussModel::Exact, &scene, &mesh);
     let relative_difference =
         |s: f64,
          linear: &mut Box<dyn truss::TrussOracle>,
@@ -157,8 +145,7 @@ fn rigid_truss_never_moves_and_every_model_refuses_bad_loads() {
     let mesh = build_mesh(&scene).unwrap();
     let pull = common::net_pull(&mesh);
     for model in [TrussModel::Rigid, TrussModel::Linear, TrussModel::Exact] {
-        let mut oracle =
-            truss::oracle(model, &scene, &mesh.truss, &SceneEffects::of(&scene)).unwrap();
+        let mut oracle = common::scene_oracle(model, &scene, &mesh);
         let short = &pull[1..];
         assert!(
             matches!(oracle.respond(short), Err(TrussError::LoadCount { .. })),
@@ -174,13 +161,7 @@ fn rigid_truss_never_moves_and_every_model_refuses_bad_loads() {
             "{model:?}"
         );
     }
-    let mut rigid = truss::oracle(
-        TrussModel::Rigid,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut rigid = common::scene_oracle(TrussModel::Rigid, &scene, &mesh);
     let r = rigid.respond(&pull).unwrap();
     assert_eq!(r.positions_m, rigid.attachments());
 }
@@ -190,22 +171,10 @@ fn exact_truss_warm_start_reproduces_the_cold_solution() {
     let scene = common::scene("small-hex");
     let mesh = build_mesh(&scene).unwrap();
     let pull = common::net_pull(&mesh);
-    let mut warm = truss::oracle(
-        TrussModel::Exact,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut warm = common::scene_oracle(TrussModel::Exact, &scene, &mesh);
     warm.respond(&common::scaled(&pull, 0.5)).unwrap();
     let from_warm = warm.respond(&pull).unwrap().positions_m;
-    let mut cold = truss::oracle(
-        TrussModel::Exact,
-        &scene,
-        &mesh.truss,
-        &SceneEffects::of(&scene),
-    )
-    .unwrap();
+    let mut cold = common::scene_oracle(TrussModel::Exact, &scene, &mesh);
     let from_cold = cold.respond(&pull).unwrap().positions_m;
     let d = max_displacement(
         &from_cold,

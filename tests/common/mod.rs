@@ -15,11 +15,14 @@ use std::process::{Command, Output};
 use nalgebra::{UnitQuaternion, Vector3};
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use ringmesh::design::{scene_problem, TiedNets};
+use ringmesh::effects::SceneEffects;
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::{build_mesh, ReflectorMesh};
 use ringmesh::mechanics::rotation::exp;
 use ringmesh::mechanics::{State, StaticSettings, StaticSolution, StaticSolver};
 use ringmesh::network::{CableGroup, Network};
+use ringmesh::scene::TrussModel;
+use ringmesh::truss::{self, TrussOracle};
 use ringmesh::uniformity::UniformityProblem;
 use ringmesh::Scene;
 
@@ -139,6 +142,16 @@ pub fn max_abs_diff(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         .zip(b)
         .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
         .fold(0.0, f64::max)
+}
+
+/// A fresh truss oracle of `model` for `scene`'s truss on `mesh`, with the
+/// effects the scene asks for.
+pub fn scene_oracle(
+    model: TrussModel,
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+) -> Box<dyn TrussOracle> {
+    truss::oracle(model, scene, &mesh.truss, &SceneEffects::of(scene)).expect("the truss builds")
 }
 
 /// The pull of the scene's net (forward FDM with its initial q) on the hinges.
