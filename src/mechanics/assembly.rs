@@ -1,5 +1,7 @@
 //! Sparse assembly of the residual and the consistent tangent of a [`Model`],
-//! joints by Lagrange multipliers, and their solution (faer sparse LU).
+//! joints by Lagrange multipliers, and their solution: dense LU for small
+//! systems, the cable net condensed onto the frame when the model has one
+//! ([`super::condensed`]), faer's sparse LU otherwise.
 //!
 //! Unknowns: the free components of every node's increment `(δx, δθ)` (fixed
 //! components are eliminated), then one multiplier per joint equation. The
@@ -11,8 +13,10 @@
 //! ```
 //!
 //! stays balanced for thin tubes (EA·L²/EI up to 1e8). The sparsity pattern and
-//! the symbolic LU are computed once; each Newton iteration refills values in
+//! the symbolic factorisation are computed once; each Newton iteration refills values in
 //! the same order and refactors numerically.
+
+use std::sync::Arc;
 
 use faer::linalg::solvers::PartialPivLu;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -20,6 +24,7 @@ use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatMut};
 use rayon::prelude::*;
 
+use super::condensed::{Condensation, CondensedError, CondensedFactor};
 use super::joint::ConstraintRow;
 use super::model::{MechanicsError, Model};
 use super::node::Frame;
@@ -41,10 +46,12 @@ const DENSE_ROWS: usize = 64;
 pub(crate) enum Factor {
     Dense(PartialPivLu<f64>),
     Sparse(Lu<usize, f64>),
+    /// The cable net's points condensed onto the frame.
+    Condensed(CondensedFactor),
 }
 
 /// Why the tangent could not be factored.
-#[derive(Debug, Clone, Copy, thiserror::Error)]
+#[derive(Debug, Clone, thiserror::Error)]
 pub(crate) enum FactorError {
     /// A pivot of the dense LU at or below the roundoff of a zero pivot,
     /// `n ε ‖J‖max`, or not a number: a mechanism.
@@ -63,9 +70,12 @@ pub(crate) enum FactorError {
     /// faer's sparse LU failed (a structurally singular matrix, or memory).
     #[error("{0:?}")]
     SparseLu(faer::sparse::linalg::LuError),
+    /// The cable net could not be condensed onto the frame.
+    #[error(transparent)]
+    Condensed(#[from] CondensedError),
 }
 
-/// The assembled problem's structure: dof numbering, pattern, symbolic LU.
+/// The assembled problem's structure: dof numbering, pattern, symbolic factorisation.
 pub(crate) struct System {
     /// Global unknown of node n's component c (or `FIXED`).
     dof: Vec<[usize; 6]>,
@@ -78,7 +88,10 @@ pub(crate) struct System {
     pattern: Vec<Pair<usize, usize>>,
     symbolic: SymbolicSparseColMat<usize>,
     argsort: Argsort<usize>,
-    lu: SymbolicLu<usize>,
+    /// The net's points condensed onto the rest, when the model has points.
+    condensation: Option<Arc<Condensation>>,
+    /// The symbolic LU of the whole tangent, when it has no points.
+    lu: Option<SymbolicLu<usize>>,
 }
 
 /// The state of the unknowns: node frames and scaled multipliers.
@@ -215,9 +228,37 @@ impl System {
                     detail: format!("sparsity pattern: {e:?}"),
                 }
             })?;
-        let lu = SymbolicLu::try_new(symbolic.as_ref()).map_err(|e| MechanicsError::Mechanism {
-            detail: format!("symbolic LU: {e:?}"),
-        })?;
+        // The net's points: translations of nodes that only cables hold.
+        let mut held_otherwise = vec![false; model.node_count()];
+        for n in model.elements.iter().flat_map(|e| e.nodes) {
+            held_otherwise[n] = true;
+        }
+        for n in model.joints.iter().flat_map(|j| j.nodes) {
+            held_otherwise[n] = true;
+        }
+        let mut point = vec![false; n_rows];
+        for (n, d) in dof.iter().enumerate() {
+            if model.node_dofs[n] == 3 && !held_otherwise[n] {
+                for &i in d[..3].iter().filter(|&&i| i != FIXED) {
+                    point[i] = true;
+                }
+            }
+        }
+        let condensation = if n_rows > DENSE_ROWS {
+            Condensation::new(n_rows, &pattern, &point)
+                .map_err(|detail| MechanicsError::Mechanism { detail })?
+                .map(Arc::new)
+        } else {
+            None
+        };
+        let lu = match condensation {
+            Some(_) => None,
+            None => Some(SymbolicLu::try_new(symbolic.as_ref()).map_err(|e| {
+                MechanicsError::Mechanism {
+                    detail: format!("symbolic LU: {e:?}"),
+                }
+            })?),
+        };
         Ok(System {
             dof,
             n_free,
@@ -227,6 +268,7 @@ impl System {
             pattern,
             symbolic,
             argsort,
+            condensation,
             lu,
         })
     }
@@ -377,10 +419,7 @@ impl System {
     /// the roundoff of a zero pivot (a mechanism).
     pub fn factor(&self, values: &[f64]) -> Result<Factor, FactorError> {
         if self.n_rows <= DENSE_ROWS {
-            let mut dense = Mat::<f64>::zeros(self.n_rows, self.n_rows);
-            for (p, v) in self.pattern.iter().zip(values) {
-                dense[(p.row, p.col)] += v;
-            }
+            let dense = self.dense_tangent(values);
             let largest = norm_inf(values);
             let lu = dense.partial_piv_lu();
             let roundoff = self.n_rows as f64 * f64::EPSILON * largest;
@@ -398,11 +437,25 @@ impl System {
             }
             return Ok(Factor::Dense(lu));
         }
+        let lu = match (&self.condensation, &self.lu) {
+            (Some(condensation), _) => return Ok(Factor::Condensed(condensation.factor(values)?)),
+            (None, Some(lu)) => lu,
+            (None, None) => unreachable!("a system without points has a symbolic LU"),
+        };
         let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
             .map_err(FactorError::SparseMatrix)?;
-        Lu::try_new_with_symbolic(self.lu.clone(), matrix.as_ref())
+        Lu::try_new_with_symbolic(lu.clone(), matrix.as_ref())
             .map(Factor::Sparse)
             .map_err(FactorError::SparseLu)
+    }
+
+    /// The tangent with `values` (pattern order) as a dense matrix.
+    pub(crate) fn dense_tangent(&self, values: &[f64]) -> Mat<f64> {
+        let mut dense = Mat::<f64>::zeros(self.n_rows, self.n_rows);
+        for (p, v) in self.pattern.iter().zip(values) {
+            dense[(p.row, p.col)] += v;
+        }
+        dense
     }
 
     /// Solve `J Δ = rhs` in place with a factor of the tangent.
@@ -411,6 +464,7 @@ impl System {
         match lu {
             Factor::Dense(lu) => lu.solve_in_place_with_conj(faer::Conj::No, rhs),
             Factor::Sparse(lu) => lu.solve_in_place_with_conj(faer::Conj::No, rhs),
+            Factor::Condensed(factor) => factor.solve_in_place(rhs),
         }
     }
 

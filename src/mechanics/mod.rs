@@ -12,6 +12,8 @@
 //!   spherical joints as constraints (eq. 22–25);
 //! * `model` — nodes, rods, bodies, joints, supports, loads: a validated frame;
 //! * `assembly` — the residual and the consistent tangent, factored;
+//!   `condensed` — the factor of a tangent with a cable net, the net
+//!   condensed onto the frame;
 //! * `settings` — what a solve takes and returns; `solver` — the solver's
 //!   core: convergence test, weighted norm of increments;
 //! * `load_control` — Newton–Raphson with adaptive load stepping;
@@ -27,6 +29,7 @@ mod arc_length;
 mod assembly;
 mod beam;
 mod cable;
+mod condensed;
 mod joint;
 mod limit;
 mod load_control;
