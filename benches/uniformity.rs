@@ -9,10 +9,12 @@
 //!   refined to ~10³, 10⁴ and 3·10⁴ net nodes (the id is the node count, front +
 //!   rear); `RINGMESH_BENCH_RINGS=57` adds a ~10⁵-node net;
 //! * `lp_independent` — the `lp` optimum of independently generated tied nets
-//!   (`tests/common/hexnet.rs`: hexagonal grid on a 100 m aperture, shuffled
-//!   nodes and cables, every free node on its own anchor) of ~10³ and ~10⁴
-//!   free nodes (the id is the free node count); `RINGMESH_BENCH_FREE=100000`
-//!   adds a ~10⁵-node net (≈ 20 s a solve);
+//!   (`tests/common/hexnet.rs`: hexagonal grid, shuffled nodes and cables,
+//!   every free node on its own anchor) of ~10³ and ~10⁴ free nodes, of two
+//!   kinds: `hex5/<free>`, the kind of `tests/data/hex5-lp.json` (D = 26 m,
+//!   F = 4 m, sag 5 %: issue 15's target net), and `100m/<free>` (D = 100 m,
+//!   F/D = 0.4); `RINGMESH_BENCH_FREE=100000` adds ~10⁵-node nets of both
+//!   (20–40 s a solve);
 //! * `gradient_nodes` — the `gradient` solver on the paper scene with 3 rings
 //!   (362 net nodes).
 //!
@@ -118,10 +120,10 @@ fn lp_nodes(c: &mut Criterion) {
     group.finish();
 }
 
-/// The `lp` problem of a generated tied net of about `free` free nodes: every
-/// cable but the hangers in the set.
-fn independent_problem(free: usize) -> UniformityProblem {
-    let network = hexnet::HexNet::with_free_nodes(free, 100.0).build();
+/// The `lp` problem of a generated tied net: every cable but the hangers in
+/// the set.
+fn independent_problem(net: hexnet::HexNet) -> UniformityProblem {
+    let network = net.build();
     let edges = (0..network.n_edges())
         .filter(|&k| network.group_of(k) != "hangers")
         .collect();
@@ -150,11 +152,18 @@ fn lp_independent(c: &mut Criterion) {
         .sample_size(10)
         .measurement_time(Duration::from_secs(10));
     for free in sizes {
-        let p = independent_problem(free);
-        let free = p.structure().free_nodes().len();
-        group.bench_with_input(BenchmarkId::from_parameter(free), &p, |b, p| {
-            b.iter(|| Lp.solve(p))
-        });
+        let rings = hexnet::HexNet::with_free_nodes(free, 100.0).rings;
+        let kinds = [
+            ("hex5", hexnet::HexNet::like_hex5(rings)),
+            ("100m", hexnet::HexNet::with_free_nodes(free, 100.0)),
+        ];
+        for (kind, net) in kinds {
+            let p = independent_problem(net);
+            let free = p.structure().free_nodes().len();
+            group.bench_with_input(BenchmarkId::new(kind, free), &p, |b, p| {
+                b.iter(|| Lp.solve(p))
+            });
+        }
     }
     group.finish();
 }

@@ -19,7 +19,7 @@
 //! `G` comes out of one sparse LDLᵀ: the quasi-definite matrix
 //!
 //! ```text
-//! M = ⎡ A   Cᵀ ⎤     (attachment unknowns ordered last, τ = max Aᵢᵢ)
+//! M = ⎡ A   Cᵀ ⎤     (attachment unknowns last, τ > 0 the scale of A's diagonal)
 //!     ⎣ C  −τI ⎦
 //! ```
 //!
@@ -134,7 +134,9 @@ pub(crate) struct Condensation {
     rest: Vec<usize>,
     /// Index in `rest` of each attachment unknown (`M`'s last rows).
     coupled: Vec<usize>,
-    /// Tangent positions of `A`'s diagonal (for `τ`).
+    /// Tangent positions of the contributions to `A`'s diagonal: `τ` is the
+    /// largest (any `τ > 0` gives the same `G`; `A`'s scale keeps `Σ` as
+    /// well conditioned as `G + τI` can be).
     diagonal: Vec<usize>,
     m: Block,
     s: Block,
