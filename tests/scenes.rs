@@ -249,3 +249,47 @@ fn offset_scene_keeps_ties_vertical_and_rim_on_a_plane() {
         "{centre_tie} vs {expected}"
     );
 }
+
+/// Every shipped scene runs `design` with the defaults (issue 20): the loop
+/// converges, the design assembles on the paraboloid holding its tensions,
+/// and the ring carries its net with a margin of 2 or more. The super-large
+/// scenes run in `tests/super_large.rs`, coarsened for CI.
+#[test]
+fn every_shipped_scene_designs_with_the_defaults() {
+    let scenes: Vec<PathBuf> = problems()
+        .into_iter()
+        .filter(|p| {
+            !p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("super-")
+        })
+        .collect();
+    assert!(scenes.len() >= 4, "{scenes:?}");
+    for path in scenes {
+        let dir = tempfile::tempdir().unwrap();
+        let outcome = ringmesh::run::design(
+            &path,
+            &ringmesh::design::DesignSettings::default(),
+            Some(dir.path()),
+            &mut |_, _| {},
+        )
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let r = &outcome.report;
+        let name = path.display();
+        assert!(
+            r.boundary_residual_m <= 1e-6,
+            "{name}: {}",
+            r.boundary_residual_m
+        );
+        let v = &r.verification;
+        assert!(v.rms_mm <= 1e-3, "{name}: RMS {} mm", v.rms_mm);
+        assert!(
+            v.max_tension_change_pct <= 0.05,
+            "{name}: {} %",
+            v.max_tension_change_pct
+        );
+        let margin = r.limit_margin.as_ref().unwrap();
+        assert!(margin.stable_to >= 2.0, "{name}: {margin:?}");
+    }
+}
