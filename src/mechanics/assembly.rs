@@ -88,10 +88,16 @@ pub(crate) struct System {
     pattern: Vec<Pair<usize, usize>>,
     symbolic: SymbolicSparseColMat<usize>,
     argsort: Argsort<usize>,
-    /// The net's points condensed onto the rest, when the model has points.
-    condensation: Option<Arc<Condensation>>,
-    /// The symbolic LU of the whole tangent, when it has no points.
-    lu: Option<SymbolicLu<usize>>,
+    /// How the tangent is factored above [`DENSE_ROWS`].
+    sparse: SparseFactorisation,
+}
+
+/// The symbolic factorisation of a sparse tangent.
+enum SparseFactorisation {
+    /// The cable net's points condensed onto the rest (a model with points).
+    Condensed(Arc<Condensation>),
+    /// faer's sparse LU of the whole tangent.
+    Lu(SymbolicLu<usize>),
 }
 
 /// The state of the unknowns: node frames and scaled multipliers.
@@ -247,18 +253,18 @@ impl System {
         let condensation = if n_rows > DENSE_ROWS {
             Condensation::new(n_rows, &pattern, &point)
                 .map_err(|detail| MechanicsError::Mechanism { detail })?
-                .map(Arc::new)
         } else {
             None
         };
-        let lu = match condensation {
-            Some(_) => None,
-            None => Some(SymbolicLu::try_new(symbolic.as_ref()).map_err(|e| {
-                MechanicsError::Mechanism {
-                    detail: format!("symbolic LU: {e:?}"),
-                }
-            })?),
-        };
+        let sparse =
+            match condensation {
+                Some(condensation) => SparseFactorisation::Condensed(Arc::new(condensation)),
+                None => SparseFactorisation::Lu(SymbolicLu::try_new(symbolic.as_ref()).map_err(
+                    |e| MechanicsError::Mechanism {
+                        detail: format!("symbolic LU: {e:?}"),
+                    },
+                )?),
+            };
         Ok(System {
             dof,
             n_free,
@@ -268,8 +274,7 @@ impl System {
             pattern,
             symbolic,
             argsort,
-            condensation,
-            lu,
+            sparse,
         })
     }
 
@@ -437,10 +442,9 @@ impl System {
             }
             return Ok(Factor::Dense(lu));
         }
-        let lu = match (&self.condensation, &self.lu) {
-            (Some(condensation), _) => return Ok(Factor::Condensed(condensation.factor(values)?)),
-            (None, Some(lu)) => lu,
-            (None, None) => unreachable!("a system without points has a symbolic LU"),
+        let lu = match &self.sparse {
+            SparseFactorisation::Condensed(c) => return Ok(Factor::Condensed(c.factor(values)?)),
+            SparseFactorisation::Lu(lu) => lu,
         };
         let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
             .map_err(FactorError::SparseMatrix)?;
