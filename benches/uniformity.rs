@@ -29,8 +29,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use ringmesh::design::scene_problem;
 use ringmesh::uniformity::{
-    Bisection, Gradient, Lp, SolverKind, SurfaceTarget, UniformityProblem, UniformitySet,
-    UniformitySolver,
+    Bisection, Gradient, Lp, SolverKind, UniformityProblem, UniformitySolver,
 };
 use ringmesh::Scene;
 
@@ -120,24 +119,6 @@ fn lp_nodes(c: &mut Criterion) {
     group.finish();
 }
 
-/// The `lp` problem of a generated tied net: every cable but the hangers in
-/// the set.
-fn independent_problem(net: hexnet::HexNet) -> UniformityProblem {
-    let network = net.build();
-    let edges = (0..network.n_edges())
-        .filter(|&k| network.group_of(k) != "hangers")
-        .collect();
-    let fixed = network.fixed_mask();
-    let surface = (0..network.n_nodes()).filter(|&i| !fixed[i]).collect();
-    let set = UniformitySet {
-        name: "surface+rim".into(),
-        edges,
-        mean_tension_n: 50.0,
-    };
-    UniformityProblem::new(network, vec![set], surface, SurfaceTarget::Prescribed, 1e9)
-        .expect("a generated net")
-}
-
 fn lp_independent(c: &mut Criterion) {
     let mut sizes = vec![1_000, 10_000];
     if let Ok(extra) = std::env::var("RINGMESH_BENCH_FREE") {
@@ -158,7 +139,7 @@ fn lp_independent(c: &mut Criterion) {
             ("100m", hexnet::HexNet::with_free_nodes(free, 100.0)),
         ];
         for (kind, net) in kinds {
-            let p = independent_problem(net);
+            let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
             let free = p.structure().free_nodes().len();
             group.bench_with_input(BenchmarkId::new(kind, free), &p, |b, p| {
                 b.iter(|| Lp.solve(p))

@@ -7,25 +7,13 @@
 
 mod common;
 
-use common::hexnet::HexNet;
+use common::hexnet::{self, HexNet};
 use ringmesh::network::Network;
-use ringmesh::uniformity::{
-    Bisection, Design, Lp, Route, SurfaceTarget, UniformityProblem, UniformitySet, UniformitySolver,
-};
+use ringmesh::uniformity::{Bisection, Design, Lp, Route, UniformityProblem, UniformitySolver};
 
 /// The uniformity problem of a generated net: `surface` and `rim` together.
 fn problem(network: Network) -> UniformityProblem {
-    let edges = (0..network.n_edges())
-        .filter(|&k| matches!(network.group_of(k), "surface" | "rim"))
-        .collect();
-    let fixed = network.fixed_mask();
-    let surface = (0..network.n_nodes()).filter(|&i| !fixed[i]).collect();
-    let set = UniformitySet {
-        name: "surface+rim".into(),
-        edges,
-        mean_tension_n: 50.0,
-    };
-    UniformityProblem::new(network, vec![set], surface, SurfaceTarget::Prescribed, 1e9).unwrap()
+    hexnet::tied_net_problem(network, "hangers", 50.0, 1e9)
 }
 
 /// Clarabel on the full problem: ratio bisection of full LP feasibility.
@@ -79,20 +67,7 @@ fn the_generator_reproduces_the_reference_net() {
 
 #[test]
 fn the_reference_net_takes_the_plan_route() {
-    let network = common::reference_network();
-    let edges = (0..network.n_edges())
-        .filter(|&k| network.group_of(k) != "tie")
-        .collect();
-    let fixed = network.fixed_mask();
-    let surface = (0..network.n_nodes()).filter(|&i| !fixed[i]).collect();
-    let set = UniformitySet {
-        name: "front+boundary".into(),
-        edges,
-        mean_tension_n: 70.0,
-    };
-    let problem =
-        UniformityProblem::new(network, vec![set], surface, SurfaceTarget::Prescribed, 1e6)
-            .unwrap();
+    let problem = hexnet::tied_net_problem(common::reference_network(), "tie", 70.0, 1e6);
     let design = Lp.solve(&problem).unwrap();
     assert_eq!(
         design.route,

@@ -8,13 +8,43 @@
 //! order and the ends of each cable shuffled with a fixed seed; groups
 //! `surface` (interior), `rim` (the outer ring), `hangers` (ties).
 //!
-//! Self-contained (only `ringmesh::network::Network`) so that a bench can
-//! include it with `#[path = "../tests/common/hexnet.rs"] mod hexnet;`.
+//! Self-contained (only `ringmesh`) so that a bench can include it with
+//! `#[path = "../tests/common/hexnet.rs"] mod hexnet;`.
 #![allow(dead_code)]
 
 use std::collections::HashMap;
 
 use ringmesh::network::Network;
+use ringmesh::uniformity::{SurfaceTarget, UniformityProblem, UniformitySet};
+
+/// The `lp` problem of a tied net: one set of every cable but those of the
+/// group `ties` at `mean_tension_n`, every free node on the surface, the
+/// bound `[q]` at `max_q`.
+pub fn tied_net_problem(
+    network: Network,
+    ties: &str,
+    mean_tension_n: f64,
+    max_q: f64,
+) -> UniformityProblem {
+    let edges = (0..network.n_edges())
+        .filter(|&k| network.group_of(k) != ties)
+        .collect();
+    let fixed = network.fixed_mask();
+    let surface = (0..network.n_nodes()).filter(|&i| !fixed[i]).collect();
+    let set = UniformitySet {
+        name: format!("all but {ties}"),
+        edges,
+        mean_tension_n,
+    };
+    UniformityProblem::new(
+        network,
+        vec![set],
+        surface,
+        SurfaceTarget::Prescribed,
+        max_q,
+    )
+    .expect("a tied net's problem")
+}
 
 /// The parameters of one generated net.
 #[derive(Debug, Clone, Copy)]
