@@ -132,6 +132,7 @@ fn bench_design(c: &mut Criterion) {
                     network,
                     &outcome.design,
                     AssemblyTruss::Flexible,
+                    None,
                 )
                 .expect("the converged design assembles")
             })

@@ -34,6 +34,7 @@ fn assemble(
         network,
         design,
         truss,
+        None,
     )
     .unwrap();
     let expected = if scene.effects.cable_elasticity {

@@ -46,6 +46,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
         outcome.problem.network(),
         &outcome.design,
         AssemblyTruss::Flexible,
+        None,
     )
     .unwrap();
     assert!(designed.slack_cables.is_empty());
@@ -68,6 +69,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
         rigid.problem.network(),
         &rigid.design,
         AssemblyTruss::Flexible,
+        None,
     )
     .unwrap();
     assert!(
@@ -165,6 +167,7 @@ fn rigid_assembly_of_a_rigid_truss_design_returns_the_design() {
         design.problem.network(),
         &design.design,
         AssemblyTruss::Rigid,
+        None,
     )
     .unwrap();
     assert!(v.max_node_shift_mm <= 1e-6, "{} mm", v.max_node_shift_mm);

@@ -587,6 +587,7 @@ fn slack_cables_in_verification_are_reported_and_carry_nothing() {
         network,
         &slackened,
         AssemblyTruss::Flexible,
+        None,
     )
     .unwrap();
     assert_eq!(v.slack_cables, scattered, "slack cables reported");
@@ -602,6 +603,7 @@ fn slack_cables_in_verification_are_reported_and_carry_nothing() {
         &reduced_net,
         &reduced_design,
         AssemblyTruss::Flexible,
+        None,
     )
     .unwrap();
     assert!(reference.slack_cables.is_empty());
@@ -628,6 +630,7 @@ fn slack_cables_in_verification_are_reported_and_carry_nothing() {
         network,
         &floating,
         AssemblyTruss::Flexible,
+        None,
     )
     .unwrap();
     assert_eq!(f.slack_cables, centre);

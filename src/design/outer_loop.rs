@@ -10,7 +10,7 @@ use super::relaxation::{Relaxation, RelaxationKind};
 use super::tied_nets::{TiedDesign, TiedNets};
 use super::DesignError;
 use crate::algebra::norm3;
-use crate::truss::TrussOracle;
+use crate::truss::{TrussEquilibrium, TrussOracle};
 use crate::uniformity::{Design, Termination, UniformityProblem, UniformitySolver};
 
 /// Settings of the outer loop: plain data with defaults.
@@ -127,6 +127,9 @@ pub struct LoopOutcome {
     pub boundary_m: Vec<[f64; 3]>,
     /// The truss's attachment points under that design's pull, `G(C_k)`, m.
     pub deformed_m: Vec<[f64; 3]>,
+    /// The truss's equilibrium under that pull, when its model has a frame
+    /// state ([`TrussOracle::equilibrium`]): the assembly's start.
+    pub truss_equilibrium: Option<TrussEquilibrium>,
     /// One record per outer iteration.
     pub history: Vec<IterationRecord>,
     /// How the loop ended.
@@ -246,6 +249,7 @@ pub fn design_loop_with(
                 truss_deforms: oracle.deforms(),
                 boundary_m: unflatten(&x),
                 deformed_m: response.positions_m,
+                truss_equilibrium: oracle.equilibrium(),
                 history,
                 termination: if converged {
                     LoopTermination::Converged

@@ -293,7 +293,15 @@ pub fn run(
     timings.margin_s = stage.elapsed().as_secs_f64();
     let stage = Instant::now();
     let network = outcome.problem.network().clone();
-    let verification = verify(scene, mesh, effects, &network, &outcome.design, assembly)?;
+    let verification = verify(
+        scene,
+        mesh,
+        effects,
+        &network,
+        &outcome.design,
+        assembly,
+        outcome.truss_equilibrium.as_ref(),
+    )?;
     timings.verification_s = stage.elapsed().as_secs_f64();
     let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
@@ -307,6 +315,7 @@ pub fn run(
             outcome.initial.problem.network(),
             &outcome.initial.design,
             AssemblyTruss::Flexible,
+            None,
         )?),
     };
     timings.conventional_s = stage.elapsed().as_secs_f64();

@@ -499,6 +499,7 @@ fn measure(
         network,
         design,
         AssemblyTruss::Flexible,
+        None,
     )
     .map(|v| {
         let built_ratio = outcome

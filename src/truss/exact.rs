@@ -10,9 +10,11 @@ use std::time::Instant;
 use nalgebra::Vector3;
 
 use super::builder::RingTruss;
-use super::response::{check_loads, layout_points, TrussError, TrussOracle, TrussResponse};
+use super::response::{
+    check_loads, layout_points, TrussEquilibrium, TrussError, TrussOracle, TrussResponse,
+};
 use crate::geometry::RingTrussLayout;
-use crate::mechanics::{NodalLoad, NodeId, State, StaticSettings, StaticSolver};
+use crate::mechanics::{constraint_scale, NodalLoad, NodeId, State, StaticSettings, StaticSolver};
 
 /// The first load step of a solve from the unloaded truss, as a fraction of
 /// the loads. Load control tells a step that jumps past a limit point by the
@@ -140,6 +142,13 @@ impl TrussOracle for ExactTruss {
         };
         self.previous = Some(solution.state);
         Ok(response)
+    }
+
+    fn equilibrium(&self) -> Option<TrussEquilibrium> {
+        self.previous.clone().map(|state| TrussEquilibrium {
+            state,
+            constraint_scale: constraint_scale(self.solver.model()),
+        })
     }
 }
 

@@ -24,6 +24,6 @@ pub use exact::ExactTruss;
 pub use linear::LinearTruss;
 pub use margin::{limit_margin, PRECISION as MARGIN_PRECISION, SEARCH_TO as MARGIN_SEARCH_TO};
 pub use registry::oracle;
-pub use response::{layout_points, TrussError, TrussOracle, TrussResponse};
+pub use response::{layout_points, TrussEquilibrium, TrussError, TrussOracle, TrussResponse};
 pub use rigid::RigidTruss;
 pub use scene_response::{read_loads, respond, AttachmentResponse, LoadsFile, SceneTrussResponse};

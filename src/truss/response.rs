@@ -6,7 +6,7 @@
 use serde::Serialize;
 
 use crate::geometry::RingTrussLayout;
-use crate::mechanics::{MechanicsError, StaticTermination};
+use crate::mechanics::{MechanicsError, State, StaticTermination};
 
 /// A truss model that cannot respond.
 #[derive(Debug, thiserror::Error)]
@@ -116,6 +116,21 @@ pub trait TrussOracle: Send {
     fn deforms(&self) -> bool {
         true
     }
+    /// The frame's last equilibrium, for models that have one (the exact
+    /// truss): the state an assembly of the same truss starts from.
+    fn equilibrium(&self) -> Option<TrussEquilibrium> {
+        None
+    }
+}
+
+/// An equilibrium of the exact truss's frame, as the start of a model that
+/// extends it (the assembly of the net on the truss, [`crate::verify`]).
+#[derive(Debug, Clone)]
+pub struct TrussEquilibrium {
+    /// The frame's state: the truss's nodes, then its joints' multipliers.
+    pub state: State,
+    /// The frame's constraint scale, by which its multipliers are divided.
+    pub constraint_scale: f64,
 }
 
 /// The reference attachment points of a layout: top hinges, then bottom hinges.

@@ -18,6 +18,7 @@ mod stiffening;
 
 pub use crate::effects::{CableModel, INEXTENSIBLE_STIFFENING};
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use nalgebra::Vector3;
@@ -26,13 +27,15 @@ use serde::Serialize;
 use crate::algebra::norm3;
 use crate::effects::SceneEffects;
 use crate::geometry::ReflectorMesh;
-use crate::mechanics::{constraint_scale, State};
+use crate::mechanics::constraint_scale;
 use crate::mechanics::{
     MechanicsError, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver, StaticTermination,
 };
 use crate::network::Network;
 use crate::scene::Scene;
-use crate::truss::{ExactTruss, RingTruss, RingTrussBuilder, TrussError, TrussOracle};
+use crate::truss::{
+    ExactTruss, RingTruss, RingTrussBuilder, TrussEquilibrium, TrussError, TrussOracle,
+};
 use crate::uniformity::Design;
 
 /// What the cables are assembled on.
@@ -169,6 +172,14 @@ fn array(v: &Vector3<f64>) -> [f64; 3] {
 /// points in the truss's order and sit on the boundary the design assumed) on
 /// `truss`, and solve.
 ///
+/// `equilibrium` is the flexible truss's equilibrium under the design's pull
+/// when the caller has it (the design loop's last, of the same scene's exact
+/// truss); without it, it is solved here. The loop's own is the better start:
+/// on a truss with a soft mode, two solves to the same force tolerance can
+/// differ by more than the net tolerates (a 120-bay ring with a 56 mm net
+/// cable: 3.1e-6 m at the hinges, against the loop's 6.8e-19 m fixed-point
+/// residual — and Newton diverged from the 79 N that put on the net).
+///
 /// # Errors
 /// A design of another network, an invalid assembly (named), or no
 /// equilibrium.
@@ -179,6 +190,7 @@ pub fn verify(
     network: &Network,
     design: &Design,
     truss: AssemblyTruss,
+    equilibrium: Option<&TrussEquilibrium>,
 ) -> Result<Verification, VerifyError> {
     let clock = Instant::now();
     let n_edges = network.n_edges();
@@ -277,12 +289,20 @@ pub fn verify(
     // motion being many times the cables' elastic stretch); then, if that
     // fails, from the undeformed truss with the prestrain ramped in load steps.
     let mut found = None;
-    if let Some((guess, guess_scale)) = truss_guess(scene, mesh, effects, design, truss)? {
+    let guess = match (truss, equilibrium) {
+        (AssemblyTruss::Rigid, _) => None,
+        (AssemblyTruss::Flexible, Some(e)) => Some(Cow::Borrowed(e)),
+        (AssemblyTruss::Flexible, None) => {
+            truss_guess(scene, mesh, effects, design)?.map(Cow::Owned)
+        }
+    };
+    if let Some(guess) = guess {
         let solver = StaticSolver::new(b.build()?)?;
         let mut start = solver.reference_state();
-        start.frames[..guess.frames.len()].copy_from_slice(&guess.frames);
-        start.set_multipliers(&guess);
-        start.rescale_multipliers(guess_scale / constraint_scale(solver.model()));
+        let frames = &guess.state.frames;
+        start.frames[..frames.len()].copy_from_slice(frames);
+        start.set_multipliers(&guess.state);
+        start.rescale_multipliers(guess.constraint_scale / constraint_scale(solver.model()));
         // One Newton solve, no step cuts, a few iterations: from a good
         // guess it converges at once; otherwise the ramp below is the
         // better path.
@@ -393,28 +413,18 @@ pub fn verify(
     })
 }
 
-/// The flexible truss's equilibrium under the design's pull (`None` for a
-/// rigid assembly, or when the truss finds none): the start of the
-/// assembled solve.
-/// With the truss model's constraint scale, by which its multipliers are
-/// divided.
+/// The flexible truss's equilibrium under the design's pull (`None` when
+/// the truss finds none): the start of the assembled solve.
 fn truss_guess(
     scene: &Scene,
     mesh: &ReflectorMesh,
     effects: &SceneEffects,
     design: &Design,
-    truss: AssemblyTruss,
-) -> Result<Option<(State, f64)>, VerifyError> {
-    if truss == AssemblyTruss::Rigid {
-        return Ok(None);
-    }
+) -> Result<Option<TrussEquilibrium>, VerifyError> {
     let layout = &mesh.truss;
-    let ring = RingTruss::new(scene, layout, effects)?;
-    let scale = constraint_scale(&ring.model);
-    let mut exact = ExactTruss::new(ring, layout)?;
-    let pull = design.pull_n();
-    Ok(match exact.respond(&pull) {
-        Ok(_) => exact.state().cloned().map(|s| (s, scale)),
+    let mut exact = ExactTruss::new(RingTruss::new(scene, layout, effects)?, layout)?;
+    Ok(match exact.respond(&design.pull_n()) {
+        Ok(_) => exact.equilibrium(),
         Err(_) => None,
     })
 }
