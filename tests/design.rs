@@ -6,6 +6,7 @@ mod common;
 use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
 use ringmesh::design::{scene_problem, DesignSettings};
 use ringmesh::effects::SceneEffects;
+use ringmesh::mechanics::LimitBound;
 use ringmesh::run::design;
 use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{layout_points, limit_margin, RingTruss, MARGIN_PRECISION, MARGIN_SEARCH_TO};
@@ -88,7 +89,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
         &outcome.design.pull_n(),
     )
     .unwrap();
-    assert_eq!(margin.unstable_from, None, "{margin:?}");
+    assert_eq!(margin.bound, LimitBound::SearchEnd, "{margin:?}");
     assert_eq!(margin.stable_to, MARGIN_SEARCH_TO);
     let stiffness: Vec<f64> = margin.path.iter().map(|p| p[1]).collect();
     assert!(stiffness.windows(2).all(|w| w[1] < w[0]), "{stiffness:?}");
@@ -128,7 +129,13 @@ fn a_design_past_the_truss_limit_load_is_refused() {
         &first.design.pull_n(),
     )
     .unwrap();
-    let unstable_from = margin.unstable_from.expect("the thin ring buckles");
+    // Certified: an unstable state, or the path's load maximum.
+    let unstable_from = match margin.bound {
+        LimitBound::Unstable { load_factor } | LimitBound::LoadMaximum { load_factor } => {
+            load_factor
+        }
+        _ => panic!("the thin ring buckles: {margin:?}"),
+    };
     assert!(margin.stable_to < 1.0 && unstable_from < 1.0, "{margin:?}");
     assert!(unstable_from - margin.stable_to <= MARGIN_PRECISION * unstable_from);
     let (first_stiffness, last_stiffness) = (margin.path[0][1], margin.path.last().unwrap()[1]);

@@ -361,12 +361,12 @@ pub fn design_margin(
     let pull = design.pull_n();
     let truss = RingTruss::new(scene, &mesh.truss, effects).map_err(TrussError::from)?;
     let margin = crate::truss::limit_margin(truss, &pull)?;
-    match margin.unstable_from {
-        Some(unstable_from) if margin.stable_to < 1.0 => Err(TrussError::PastLimitLoad {
+    if margin.stable_to < 1.0 {
+        return Err(TrussError::PastLimitLoad {
             stable_to: margin.stable_to,
-            unstable_from,
+            bound: margin.bound,
         }
-        .into()),
-        _ => Ok(margin),
+        .into());
     }
+    Ok(margin)
 }

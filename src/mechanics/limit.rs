@@ -9,8 +9,42 @@ use serde::Serialize;
 
 use super::assembly::State;
 use super::model::{MechanicsError, NodalLoad};
-use super::settings::StaticSettings;
+use super::settings::{PathControl, StaticSettings, StaticTermination};
 use super::solver::StaticSolver;
+use super::stability::Mode;
+
+/// What bounds the limit load from above.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum LimitBound {
+    /// Stable up to the end of the search: no bound below it.
+    SearchEnd,
+    /// Certified: the equilibrium on the path at `load_factor` has a
+    /// direction of negative curvature on the joints' constraints.
+    Unstable {
+        /// Its load factor.
+        load_factor: f64,
+    },
+    /// The path's load maximum (a limit point), passed by arc length: the
+    /// path turns back there and the state it reaches beyond is certified
+    /// unstable, so there is no equilibrium above it on this path. The
+    /// maximum is the largest load of the arc-length steps; the true one
+    /// lies above it by the steps' curvature error.
+    LoadMaximum {
+        /// The largest load factor on the path.
+        load_factor: f64,
+    },
+    /// Not certified: no equilibrium was found at `load_factor`, though the
+    /// solves started from a stable one within the search's precision below
+    /// it, and arc length from there neither passed a load maximum nor got
+    /// beyond it.
+    NotReached {
+        /// The least load factor no solve reached.
+        load_factor: f64,
+    },
+    /// The search's budget of solves ran out before a bound was found.
+    Budget,
+}
 
 /// The limit load of a frame under a multiple of its dead loads.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -18,16 +52,19 @@ pub struct LimitSearch {
     /// The largest load factor whose equilibrium (on the path from the
     /// unstressed frame) was found stable.
     pub stable_to: f64,
-    /// The least load factor with an unstable equilibrium or none at all; `None`
-    /// when the frame is stable up to `searched_to`. The limit load lies in
-    /// `[stable_to, unstable_from]`.
-    pub unstable_from: Option<f64>,
+    /// What bounds the limit load from above: the limit lies between
+    /// `stable_to` and the bound's load factor.
+    pub bound: LimitBound,
     /// The load factor the search went up to.
     pub searched_to: f64,
     /// The stable states found, `[load factor, lowest stiffness N/m]`, from
     /// the unstressed frame on: the lowest stiffness falls to zero at the
     /// limit load.
     pub path: Vec<[f64; 2]>,
+    /// The lowest mode of the last stable state: the buckling mode, near
+    /// the limit.
+    #[serde(skip)]
+    pub mode: Mode,
     /// Static solves.
     pub solves: usize,
     /// Newton iterations of all solves.
@@ -36,20 +73,34 @@ pub struct LimitSearch {
     pub time_s: f64,
 }
 
+impl std::fmt::Display for LimitBound {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LimitBound::SearchEnd => write!(f, "the end of the search"),
+            LimitBound::Unstable { load_factor } => {
+                write!(f, "unstable at {load_factor:.3} × (negative curvature)")
+            }
+            LimitBound::LoadMaximum { load_factor } => write!(
+                f,
+                "a load maximum at {load_factor:.3} × (the path turns back to unstable states)"
+            ),
+            LimitBound::NotReached { load_factor } => write!(
+                f,
+                "no equilibrium found at {load_factor:.3} × (not certified unstable)"
+            ),
+            LimitBound::Budget => write!(f, "out of solves before an upper bound"),
+        }
+    }
+}
+
 impl std::fmt::Display for LimitSearch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.unstable_from {
-            Some(hi) => write!(
-                f,
-                "stable up to {:.3} × the load, unstable (or lost) at {hi:.3} ×",
-                self.stable_to
-            ),
-            None => write!(
-                f,
-                "stable up to {} × the load, the end of the search",
-                self.stable_to
-            ),
-        }
+        let precision = if self.stable_to >= 10.0 { 1 } else { 3 };
+        write!(
+            f,
+            "stable up to {:.precision$} × the load, {}",
+            self.stable_to, self.bound
+        )
     }
 }
 
@@ -57,6 +108,17 @@ impl LimitSearch {
     /// The margin to the limit load: the load factor certified stable.
     pub fn margin(&self) -> f64 {
         self.stable_to
+    }
+
+    /// The load factor of the upper bound, certified or not (`None` when
+    /// there is none).
+    pub fn upper(&self) -> Option<f64> {
+        match self.bound {
+            LimitBound::Unstable { load_factor }
+            | LimitBound::LoadMaximum { load_factor }
+            | LimitBound::NotReached { load_factor } => Some(load_factor),
+            LimitBound::SearchEnd | LimitBound::Budget => None,
+        }
     }
 }
 
@@ -78,10 +140,13 @@ const MAX_GROWTH: f64 = 4.0;
 /// at most half-way to where the line through the last two `(λ, μ)` crosses
 /// zero (and at most ×4, `MAX_GROWTH`), so that an eigenvalue turns negative
 /// within a short step, while it is still the least in magnitude and inverse
-/// iteration finds it. The first unstable state (or a load with no
-/// equilibrium) brackets the limit, and bisection narrows the bracket. Each
-/// solve starts from the last stable state. The model's loads are restored
-/// before returning.
+/// iteration finds it. Each solve starts from the last stable state. An
+/// unstable state (negative curvature: a certificate) bounds the limit from
+/// above and bisection narrows the bracket. A solve that does not converge
+/// certifies nothing: the load is retried half-way from the last stable
+/// state, and only when no solve gets within `precision` of it is it the
+/// bound, [`LimitBound::NotReached`]. The model's loads are restored before
+/// returning.
 ///
 /// # Errors
 /// Invalid arguments or settings, or a tangent that cannot be factored at a
@@ -107,29 +172,30 @@ pub fn limit_load_factor(
     let clock = Instant::now();
     let loads = solver.model().loads().to_vec();
     let mut stable_state = solver.reference_state();
+    let unloaded = solver.stability(&stable_state, 0.0)?;
     let mut search = LimitSearch {
         stable_to: 0.0,
-        unstable_from: None,
+        bound: LimitBound::SearchEnd,
         searched_to: search_to,
-        path: vec![[
-            0.0,
-            solver
-                .stability(&stable_state, 0.0)?
-                .lowest_stiffness_n_per_m,
-        ]],
+        path: vec![[0.0, unloaded.lowest_stiffness_n_per_m]],
+        mode: unloaded.mode,
         solves: 0,
         newton_iterations: 0,
         time_s: 0.0,
     };
-    // The least load factor a solve could not reach: no certificate, but the
-    // next try stays below it.
+    // The least load factor found unstable (certified), and the least one a
+    // solve could not reach (no certificate: the next tries stay below it).
+    let mut unstable_from = f64::INFINITY;
     let mut failed_at = f64::INFINITY;
+    // The path's load maximum, once arc length has passed it (tried once).
+    let mut peak = None;
     let result = loop {
-        let ceiling = search.unstable_from.unwrap_or(f64::INFINITY).min(failed_at);
-        let halfway = 0.5 * (search.stable_to + ceiling);
-        let lambda = match search.unstable_from {
-            Some(_) => halfway,
-            None => next_trial(&search.path, search_to, precision).min(halfway),
+        let certified = unstable_from.min(peak.unwrap_or(f64::INFINITY));
+        let ceiling = certified.min(failed_at);
+        let lambda = if certified.is_finite() {
+            0.5 * (search.stable_to + ceiling)
+        } else {
+            next_trial(&search.path, search_to, precision).min(0.5 * (search.stable_to + ceiling))
         };
         let reached = match equilibrium_at(
             solver,
@@ -156,29 +222,60 @@ pub fn limit_load_factor(
                     search
                         .path
                         .push([reached.load_factor, s.lowest_stiffness_n_per_m]);
+                    search.mode = s.mode;
                     stable_state = reached.state;
                 }
-                Ok(_) => search.unstable_from = Some(reached.load_factor),
+                Ok(_) => unstable_from = unstable_from.min(reached.load_factor),
                 Err(e) => break Err(e),
             }
         }
         if !reached.converged {
-            if lambda - search.stable_to <= precision * lambda {
-                // No equilibrium within `precision` beyond a stable one.
-                search.unstable_from = Some(lambda);
-            } else {
-                failed_at = lambda;
-            }
+            failed_at = failed_at.min(lambda);
         }
-        if search.solves >= MAX_SOLVES && search.unstable_from.is_none() {
-            // Out of budget: the least load not reached bounds the limit.
-            search.unstable_from = Some(failed_at.min(search_to)).filter(|f| *f < search_to);
+        if search.stable_to >= search_to {
             break Ok(());
         }
-        match search.unstable_from {
-            None if search.stable_to >= search_to => break Ok(()),
-            Some(hi) if hi - search.stable_to <= precision * hi => break Ok(()),
-            _ => {}
+        let within =
+            |bound: f64| bound.is_finite() && bound - search.stable_to <= precision * bound;
+        if peak.is_none() && failed_at < certified && within(failed_at) {
+            // Load control fails just above a stable state: a load maximum,
+            // or Newton's failure. Arc length tells which; below a maximum
+            // the failures were Newton's, and bisection goes on up to it.
+            let found = load_maximum(
+                solver,
+                &loads,
+                failed_at,
+                &stable_state,
+                search.stable_to,
+                settings,
+            );
+            match found {
+                Ok(Some(p)) => {
+                    peak = Some(p);
+                    failed_at = f64::INFINITY;
+                    continue;
+                }
+                Ok(None) => peak = Some(f64::INFINITY),
+                Err(e) => break Err(e),
+            }
+        }
+        let certified = unstable_from.min(peak.unwrap_or(f64::INFINITY));
+        let done = within(certified) || within(failed_at) || search.solves >= MAX_SOLVES;
+        if done {
+            // The certified bound if there is one, else the failed load.
+            search.bound = match peak {
+                _ if unstable_from <= certified && unstable_from.is_finite() => {
+                    LimitBound::Unstable {
+                        load_factor: unstable_from,
+                    }
+                }
+                Some(p) if p.is_finite() => LimitBound::LoadMaximum { load_factor: p },
+                _ if failed_at.is_finite() => LimitBound::NotReached {
+                    load_factor: failed_at,
+                },
+                _ => LimitBound::Budget,
+            };
+            break Ok(());
         }
     };
     solver.model_mut().set_loads(loads)?;
@@ -205,6 +302,42 @@ fn next_trial(path: &[[f64; 2]], search_to: f64, precision: f64) -> f64 {
     trial.min(search_to)
 }
 
+/// Loads beyond `failed_at` by this fraction are the arc length's target:
+/// far enough that it passes a load maximum just above `failed_at` before it
+/// would land.
+const ARC_TARGET_MARGIN: f64 = 0.05;
+
+/// The path's load maximum above `start` (an equilibrium at `start_lambda` ×
+/// `loads`), when arc length towards `failed_at` passes one and the state it
+/// reaches beyond is certified unstable; `None` when it does not (it stalls,
+/// or the path goes on, the load-control failure having been Newton's).
+fn load_maximum(
+    solver: &mut StaticSolver,
+    loads: &[NodalLoad],
+    failed_at: f64,
+    start: &State,
+    start_lambda: f64,
+    settings: &StaticSettings,
+) -> Result<Option<f64>, MechanicsError> {
+    let target = failed_at * (1.0 + ARC_TARGET_MARGIN);
+    // A first step of about a quarter of the gap to the failed load, cut at
+    // most to a thousandth of that.
+    let first = 0.25 * (failed_at - start_lambda).max(1e-3 * failed_at) / target;
+    let arc = StaticSettings {
+        path: PathControl::ArcLength,
+        initial_step: first,
+        min_step: 1e-3 * first,
+        ..settings.clone()
+    };
+    set_scaled_loads(solver, loads, target)?;
+    let solution = solver.solve_from(start.clone(), start_lambda / target, &arc)?;
+    let StaticTermination::LimitPoint { limit_load_factor } = solution.termination else {
+        return Ok(None);
+    };
+    let beyond = solver.stability(&solution.state, solution.load_factor)?;
+    Ok((!beyond.stable).then_some(limit_load_factor * target))
+}
+
 /// How far a solve towards a load factor got.
 struct Reached {
     /// The last converged state.
@@ -227,6 +360,22 @@ fn equilibrium_at(
     start_lambda: f64,
     settings: &StaticSettings,
 ) -> Result<Reached, MechanicsError> {
+    set_scaled_loads(solver, loads, lambda)?;
+    let solution = solver.solve_from(start.clone(), start_lambda / lambda, settings)?;
+    Ok(Reached {
+        converged: solution.converged(),
+        load_factor: lambda * solution.load_factor,
+        state: solution.state,
+        newton_iterations: solution.newton_iterations,
+    })
+}
+
+/// Set `lambda` × `loads` on `solver`'s model.
+fn set_scaled_loads(
+    solver: &mut StaticSolver,
+    loads: &[NodalLoad],
+    lambda: f64,
+) -> Result<(), MechanicsError> {
     let scaled = loads
         .iter()
         .map(|l| NodalLoad {
@@ -235,14 +384,7 @@ fn equilibrium_at(
             ..*l
         })
         .collect();
-    solver.model_mut().set_loads(scaled)?;
-    let solution = solver.solve_from(start.clone(), start_lambda / lambda, settings)?;
-    Ok(Reached {
-        converged: solution.converged(),
-        load_factor: lambda * solution.load_factor,
-        state: solution.state,
-        newton_iterations: solution.newton_iterations,
-    })
+    solver.model_mut().set_loads(scaled)
 }
 
 #[cfg(test)]
@@ -313,9 +455,9 @@ mod tests {
         // Loaded at half the critical load: the margin is 2.
         let mut solver = column(16, 0.5 * p_cr);
         let search = limit_load_factor(&mut solver, 8.0, 1e-6, &StaticSettings::default()).unwrap();
-        let hi = search
-            .unstable_from
-            .expect("the column buckles below 8 × the load");
+        let LimitBound::Unstable { load_factor: hi } = search.bound else {
+            panic!("the column buckles below 8 × the load: {search:?}");
+        };
         let found = 0.5 * search.stable_to;
         // The discrete column's error: 16 elements of constant curvature on a
         // quarter sine wave, (π/32)²/12 = 8.0e-4 relative (measured at 4…64
@@ -339,7 +481,10 @@ mod tests {
         let search = limit_load_factor(&mut solver, 4.0, 1e-6, &StaticSettings::default()).unwrap();
         let expected =
             (1.0 + (std::f64::consts::PI / 32.0).powi(2) / 12.0 + p_cr / section().axial_n) / 3.0;
-        assert!(search.unstable_from.is_some());
+        assert!(
+            matches!(search.bound, LimitBound::Unstable { .. }),
+            "{search:?}"
+        );
         assert!(
             (search.margin() - expected).abs() <= 2e-5,
             "margin {}, expected {expected}: {search:?}",
@@ -351,7 +496,7 @@ mod tests {
     fn column_in_tension_is_stable_up_to_the_search_end() {
         let mut solver = column(8, -10.0 * critical_load_n());
         let search = limit_load_factor(&mut solver, 4.0, 1e-3, &StaticSettings::default()).unwrap();
-        assert_eq!(search.unstable_from, None);
+        assert_eq!(search.bound, LimitBound::SearchEnd);
         assert_eq!(search.stable_to, 4.0);
     }
 }

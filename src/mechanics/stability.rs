@@ -34,7 +34,7 @@ const EIGENVALUE_TOLERANCE: f64 = 1e-4;
 const CURVATURE_NOISE: f64 = 1e-8;
 
 /// The stability of one equilibrium state.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Stability {
     /// The least-magnitude eigenvalue of the stiffness on the constraints
     /// (rotations weighted by the mean element length), N/m: the estimate
@@ -45,6 +45,28 @@ pub struct Stability {
     pub stable: bool,
     /// Inverse iterations.
     pub iterations: usize,
+    /// The direction the estimate belongs to: the lowest mode when stable,
+    /// the direction of negative curvature otherwise.
+    #[serde(skip)]
+    pub mode: Mode,
+}
+
+/// A mode shape: every node's translation, scaled so that the largest is 1 m
+/// (its sign is arbitrary).
+#[derive(Clone, PartialEq, Default)]
+pub struct Mode(Vec<[f64; 3]>);
+
+impl Mode {
+    /// Every node's translation, m.
+    pub fn translations_m(&self) -> &[[f64; 3]] {
+        &self.0
+    }
+}
+
+impl std::fmt::Debug for Mode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Mode({} nodes)", self.0.len())
+    }
 }
 
 /// The stability of `state`, an equilibrium at load factor `lambda`.
@@ -94,25 +116,34 @@ pub(super) fn stability(
         }
         let previous = estimate;
         estimate = curvature / (z_norm * z_norm);
-        if curvature < -CURVATURE_NOISE * z_norm * x_norm {
+        let negative = curvature < -CURVATURE_NOISE * z_norm * x_norm;
+        let settled = (estimate - previous).abs() <= EIGENVALUE_TOLERANCE * estimate.abs();
+        if negative || settled || iteration == MAX_ITERATIONS {
             return Ok(Stability {
                 lowest_stiffness_n_per_m: estimate,
-                stable: false,
+                stable: !negative,
                 iterations: iteration,
-            });
-        }
-        if (estimate - previous).abs() <= EIGENVALUE_TOLERANCE * estimate.abs() {
-            return Ok(Stability {
-                lowest_stiffness_n_per_m: estimate,
-                stable: true,
-                iterations: iteration,
+                mode: translations(solver, &z),
             });
         }
         x = z.iter().map(|v| v / z_norm).collect();
     }
-    Ok(Stability {
-        lowest_stiffness_n_per_m: estimate,
-        stable: true,
-        iterations: MAX_ITERATIONS,
-    })
+    unreachable!("the last iteration returns")
+}
+
+/// Every node's translation in the unknowns `z` (0 where fixed), scaled so
+/// that the largest is 1 m.
+fn translations(solver: &StaticSolver, z: &[f64]) -> Mode {
+    let system = solver.system();
+    let mut t: Vec<[f64; 3]> = (0..solver.model().node_count())
+        .map(|n| std::array::from_fn(|c| system.unknown(n, c).map_or(0.0, |i| z[i])))
+        .collect();
+    let largest = t
+        .iter()
+        .map(|v| crate::algebra::norm3(*v))
+        .fold(0.0, f64::max);
+    if largest > 0.0 {
+        t.iter_mut().flatten().for_each(|v| *v /= largest);
+    }
+    Mode(t)
 }

@@ -6,19 +6,24 @@
 //! tell a stable state from one past a bifurcation: a ring under a symmetric
 //! pull stays on its symmetric branch past its buckling load. The margin is
 //! found on the state instead ([`crate::mechanics::Stability`]): the pull is
-//! multiplied by 1, 2, 4 until the equilibrium is unstable, then bisected.
+//! multiplied in growing steps until an equilibrium is certified unstable,
+//! then bisected ([`crate::mechanics::limit_load_factor`]); a load no solve
+//! reaches bounds the limit only as [`LimitBound::NotReached`], never as
+//! an instability.
 
 use super::builder::RingTruss;
 use super::exact::nodal_loads;
 use super::response::{check_loads, TrussError};
+#[cfg(doc)]
+use crate::mechanics::LimitBound;
 use crate::mechanics::{limit_load_factor, LimitSearch, StaticSettings, StaticSolver};
 
 /// How far the margin is searched: a truss stable at this multiple of the
 /// pull is reported as such, without its limit load.
 pub const SEARCH_TO: f64 = 4.0;
 
-/// Relative width of the bracket on the limit load.
-pub const PRECISION: f64 = 0.02;
+/// Relative width of the bracket on the limit load (issue 16: 0.5 %).
+pub const PRECISION: f64 = 0.005;
 
 /// The limit load of `truss` under multiples of `pull_n` (one force per
 /// attachment point, N) with its self weight, searched up to [`SEARCH_TO`] ×

@@ -6,7 +6,7 @@
 use serde::Serialize;
 
 use crate::geometry::RingTrussLayout;
-use crate::mechanics::{MechanicsError, State, StaticTermination};
+use crate::mechanics::{LimitBound, MechanicsError, State, StaticTermination};
 
 /// A truss model that cannot respond.
 #[derive(Debug, thiserror::Error)]
@@ -41,16 +41,14 @@ pub enum TrussError {
     /// The net's pull exceeds the truss's limit load (DESIGN §9).
     #[error(
         "the net's pull exceeds the ring truss's limit load: its equilibrium is stable up to \
-         {} × the pull and unstable (or lost) at {} × — stiffer tubes, lower tensions or a \
-         coarser net",
-        significant(*.stable_to),
-        significant(*.unstable_from)
+         {} × the pull, {bound} — stiffer tubes, lower tensions or a coarser net",
+        significant(*.stable_to)
     )]
     PastLimitLoad {
         /// The largest multiple of the pull found stable.
         stable_to: f64,
-        /// The least multiple found unstable.
-        unstable_from: f64,
+        /// What bounds the limit from above.
+        bound: LimitBound,
     },
     /// No equilibrium under the full load: the truss buckles or collapses.
     #[error(
