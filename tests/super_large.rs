@@ -120,6 +120,30 @@ fn super_60m_designs_assembles_and_keeps_its_margin() {
     );
     let margin = r.limit_margin.as_ref().unwrap();
     assert!(margin.stable_to >= 2.0, "{margin:?}");
+    // model.vtu carries the buckling mode on the truss, zero on the net,
+    // its largest translation 1.
+    let vtu = std::fs::read_to_string(dir.path().join("model.vtu")).unwrap();
+    let field = vtu
+        .split("Name=\"buckling_mode\" NumberOfComponents=\"3\" format=\"ascii\">\n")
+        .nth(1)
+        .expect("a buckling_mode field")
+        .split("</DataArray>")
+        .next()
+        .unwrap();
+    let norms: Vec<f64> = field
+        .lines()
+        .map(|l| {
+            let v: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+        })
+        .collect();
+    let net_nodes = r.net.nodes_xyz_m.len();
+    assert!(norms[..net_nodes].iter().all(|&n| n == 0.0));
+    let largest = norms[net_nodes..].iter().copied().fold(0.0, f64::max);
+    assert!(
+        (largest - 1.0).abs() <= 1e-6,
+        "largest translation {largest}"
+    );
     // The net carries the membrane stress the scene asks for: the front
     // net's mean tension is the one it resolves to.
     let scene = Scene::read(&path).unwrap();

@@ -2,6 +2,7 @@
 
 use std::fmt::Write;
 
+use crate::mechanics::Mode;
 use crate::network::Network;
 use crate::verify::Verification;
 
@@ -20,6 +21,17 @@ pub fn network_vtu(
     network: &Network,
     nodes: Option<&[[f64; 3]]>,
     forces_n: Option<&[f64]>,
+) -> String {
+    vtu_with_vectors(network, nodes, forces_n, None)
+}
+
+/// [`network_vtu`] with a named vector point field (n_nodes × 3).
+#[track_caller]
+fn vtu_with_vectors(
+    network: &Network,
+    nodes: Option<&[[f64; 3]]>,
+    forces_n: Option<&[f64]>,
+    point_vectors: Option<(&str, &[[f64; 3]])>,
 ) -> String {
     let nodes = nodes.unwrap_or(&network.nodes);
     assert_eq!(nodes.len(), network.n_nodes(), "nodes: one row per node");
@@ -73,7 +85,19 @@ pub fn network_vtu(
     for f in fixed {
         s.push_str(if f { "1\n" } else { "0\n" });
     }
-    s.push_str("</DataArray>\n</PointData>\n<CellData>\n");
+    s.push_str("</DataArray>\n");
+    if let Some((name, vectors)) = point_vectors {
+        assert_eq!(vectors.len(), n, "{name}: one row per node");
+        let _ = writeln!(
+            s,
+            "<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"3\" format=\"ascii\">"
+        );
+        for v in vectors {
+            let _ = writeln!(s, "{:e} {:e} {:e}", v[0], v[1], v[2]);
+        }
+        s.push_str("</DataArray>\n");
+    }
+    s.push_str("</PointData>\n<CellData>\n");
     s.push_str("<DataArray type=\"Float64\" Name=\"q_n_per_m\" format=\"ascii\">\n");
     for q in &network.q {
         let _ = writeln!(s, "{q:e}");
@@ -96,8 +120,19 @@ pub fn network_vtu(
 
 /// The assembled model as one `.vtu`: the net at its assembled positions (its
 /// cables carry `q_n_per_m` and the assembled `force_n`) and the deformed
-/// truss as line cells of group `truss` (q and force 0).
-pub fn assembly_vtu(network: &Network, q: &[f64], verification: &Verification) -> String {
+/// truss as line cells of group `truss` (q and force 0). With the truss's
+/// buckling `mode` (its model's nodes, [`crate::mechanics::LimitSearch::mode`]),
+/// the point field `buckling_mode` holds it on the truss (zero on the net):
+/// ParaView's *Warp By Vector* shows it.
+///
+/// # Panics
+/// If `mode` does not cover the truss's nodes.
+pub fn assembly_vtu(
+    network: &Network,
+    q: &[f64],
+    verification: &Verification,
+    mode: Option<&Mode>,
+) -> String {
     let mut combined = network.clone();
     combined.nodes = verification.nodes_xyz_m.clone();
     combined.q = q.to_vec();
@@ -115,5 +150,21 @@ pub fn assembly_vtu(network: &Network, q: &[f64], verification: &Verification) -
     }
     combined.groups = Some(groups);
     combined.loads = None;
-    network_vtu(&combined, None, Some(&forces))
+    let mode = mode.map(|mode| {
+        let shape = mode.translations_m();
+        let mut field = vec![[0.0; 3]; network.n_nodes()];
+        field.extend(
+            verification
+                .truss_segment_nodes
+                .iter()
+                .flat_map(|&[a, b]| [shape[a], shape[b]]),
+        );
+        field
+    });
+    vtu_with_vectors(
+        &combined,
+        None,
+        Some(&forces),
+        mode.as_deref().map(|m| ("buckling_mode", m)),
+    )
 }

@@ -108,7 +108,13 @@ fn write_design(
     )?;
     write_atomic(
         &path("model.vtu"),
-        assembly_vtu(network, &report.net.q, &report.verification).as_bytes(),
+        assembly_vtu(
+            network,
+            &report.net.q,
+            &report.verification,
+            report.limit_margin.as_ref().map(|m| &m.mode),
+        )
+        .as_bytes(),
     )?;
     write_atomic(
         &path("convergence.csv"),

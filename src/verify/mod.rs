@@ -150,6 +150,10 @@ pub struct Verification {
     /// The deformed truss as straight segments between beam nodes, m.
     #[serde(skip)]
     pub truss_segments_m: Vec<[[f64; 3]; 2]>,
+    /// The truss model's nodes at the ends of each segment (the ring
+    /// truss's own numbering: [`crate::truss::RingTruss`]'s model).
+    #[serde(skip)]
+    pub truss_segment_nodes: Vec<[usize; 2]>,
 }
 
 /// Newton iterations allowed from the truss guess before the ramp takes
@@ -379,20 +383,14 @@ pub fn verify(
         .zip(&design.tensions_n)
         .map(|(t, d)| ((t - d) / d).abs())
         .fold(0.0, f64::max);
-    let truss_segments_m = model
+    let truss_segment_nodes: Vec<[usize; 2]> = model
         .rods()
         .iter()
-        .flat_map(|rod| {
-            rod.nodes
-                .windows(2)
-                .map(|w| {
-                    [
-                        array(&frames[w[0]].position_m),
-                        array(&frames[w[1]].position_m),
-                    ]
-                })
-                .collect::<Vec<_>>()
-        })
+        .flat_map(|rod| rod.nodes.windows(2).map(|w| [w[0], w[1]]))
+        .collect();
+    let truss_segments_m = truss_segment_nodes
+        .iter()
+        .map(|&[a, b]| [array(&frames[a].position_m), array(&frames[b].position_m)])
         .collect();
     Ok(Verification {
         truss,
@@ -410,6 +408,7 @@ pub fn verify(
         nodes_xyz_m,
         tensions_n,
         truss_segments_m,
+        truss_segment_nodes,
     })
 }
 
