@@ -12,6 +12,20 @@ use ringmesh::mechanics::{
 };
 use ringmesh::truss::MARGIN_PRECISION;
 
+/// The limit search of the frame `b` builds, at the truss margin's
+/// precision, up to `search_to` × its loads.
+fn search_limit(b: ModelBuilder, search_to: f64) -> (StaticSolver, LimitSearch) {
+    let mut solver = StaticSolver::new(b.build().unwrap()).unwrap();
+    let search = limit_load_factor(
+        &mut solver,
+        search_to,
+        MARGIN_PRECISION,
+        &StaticSettings::default(),
+    )
+    .unwrap();
+    (solver, search)
+}
+
 /// The bracket `[stable_to, unstable_from]` of `search` (loads × `scale`)
 /// is certified, at most [`MARGIN_PRECISION`] wide, and holds `expected`
 /// within `MARGIN_PRECISION`.
@@ -58,14 +72,7 @@ fn a_clamped_free_column_buckles_at_eulers_load() {
         Vector3::new(0.0, 0.0, -0.5 * euler),
         Vector3::zeros(),
     );
-    let mut solver = StaticSolver::new(b.build().unwrap()).unwrap();
-    let search = limit_load_factor(
-        &mut solver,
-        4.0,
-        MARGIN_PRECISION,
-        &StaticSettings::default(),
-    )
-    .unwrap();
+    let (solver, search) = search_limit(b, 4.0);
     assert_brackets(&search, 0.5, 1.0);
     // The mode: lateral, the quarter sine wave along the column.
     for &n in &rod.nodes {
@@ -133,14 +140,7 @@ fn a_ring_under_radial_dead_loads_buckles_oval_at_four_ei_over_r_cubed() {
         );
         b.add_load(body, -force * point(k) / radius, Vector3::zeros());
     }
-    let mut solver = StaticSolver::new(b.build().unwrap()).unwrap();
-    let search = limit_load_factor(
-        &mut solver,
-        8.0,
-        MARGIN_PRECISION,
-        &StaticSettings::default(),
-    )
-    .unwrap();
+    let (_, search) = search_limit(b, 8.0);
     assert_brackets(&search, 1.0, 4.0);
     // The mode: radial motion cos 2θ (its sign and scale aside).
     let radial: Vec<f64> = (0..bays)

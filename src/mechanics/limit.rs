@@ -188,9 +188,10 @@ pub fn limit_load_factor(
     let mut unstable_from = f64::INFINITY;
     let mut failed_at = f64::INFINITY;
     // The path's load maximum, once arc length has passed it (tried once).
-    let mut peak = None;
+    let mut peak = f64::INFINITY;
+    let mut arc_tried = false;
     let result = loop {
-        let certified = unstable_from.min(peak.unwrap_or(f64::INFINITY));
+        let certified = unstable_from.min(peak);
         let ceiling = certified.min(failed_at);
         let lambda = if certified.is_finite() {
             0.5 * (search.stable_to + ceiling)
@@ -237,7 +238,8 @@ pub fn limit_load_factor(
         }
         let within =
             |bound: f64| bound.is_finite() && bound - search.stable_to <= precision * bound;
-        if peak.is_none() && failed_at < certified && within(failed_at) {
+        if !arc_tried && failed_at < certified && within(failed_at) {
+            arc_tried = true;
             // Load control fails just above a stable state: a load maximum,
             // or Newton's failure. Arc length tells which; below a maximum
             // the failures were Newton's, and bisection goes on up to it.
@@ -251,29 +253,30 @@ pub fn limit_load_factor(
             );
             match found {
                 Ok(Some(p)) => {
-                    peak = Some(p);
+                    peak = p;
                     failed_at = f64::INFINITY;
                     continue;
                 }
-                Ok(None) => peak = Some(f64::INFINITY),
+                Ok(None) => {}
                 Err(e) => break Err(e),
             }
         }
-        let certified = unstable_from.min(peak.unwrap_or(f64::INFINITY));
+        let certified = unstable_from.min(peak);
         let done = within(certified) || within(failed_at) || search.solves >= MAX_SOLVES;
         if done {
             // The certified bound if there is one, else the failed load.
-            search.bound = match peak {
-                _ if unstable_from <= certified && unstable_from.is_finite() => {
-                    LimitBound::Unstable {
-                        load_factor: unstable_from,
-                    }
+            search.bound = if unstable_from.is_finite() && unstable_from <= peak {
+                LimitBound::Unstable {
+                    load_factor: unstable_from,
                 }
-                Some(p) if p.is_finite() => LimitBound::LoadMaximum { load_factor: p },
-                _ if failed_at.is_finite() => LimitBound::NotReached {
+            } else if peak.is_finite() {
+                LimitBound::LoadMaximum { load_factor: peak }
+            } else if failed_at.is_finite() {
+                LimitBound::NotReached {
                     load_factor: failed_at,
-                },
-                _ => LimitBound::Budget,
+                }
+            } else {
+                LimitBound::Budget
             };
             break Ok(());
         }
