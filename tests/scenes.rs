@@ -7,6 +7,8 @@ use std::path::PathBuf;
 
 use ringmesh::fdm::solve_network;
 use ringmesh::geometry::build_mesh;
+use ringmesh::mechanics::LimitBound;
+use ringmesh::truss::MARGIN_PRECISION;
 use ringmesh::{CableGroup, Scene, SceneError};
 
 fn problems() -> Vec<PathBuf> {
@@ -291,5 +293,20 @@ fn every_shipped_scene_designs_with_the_defaults() {
         );
         let margin = r.limit_margin.as_ref().unwrap();
         assert!(margin.stable_to >= 2.0, "{name}: {margin:?}");
+        // Below the search's end the limit is bracketed to 0.5 % (issue 16)
+        // by a certified bound: every shipped ring has a load maximum.
+        if let Some(upper) = margin.upper() {
+            assert!(
+                matches!(
+                    margin.bound,
+                    LimitBound::Unstable { .. } | LimitBound::LoadMaximum { .. }
+                ),
+                "{name}: {margin:?}"
+            );
+            assert!(
+                upper - margin.stable_to <= MARGIN_PRECISION * upper,
+                "{name}: {margin:?}"
+            );
+        }
     }
 }

@@ -42,6 +42,19 @@ pub(super) fn follow(
     lambda0: f64,
     settings: &StaticSettings,
 ) -> StaticSolution {
+    follow_observed(solver, start, lambda0, settings, &mut |_, _, _| {})
+}
+
+/// [`follow`], calling `observe(state, load factor, arc length)` at every
+/// converged arc-length step (not at the landing on λ = 1), the arc length
+/// being the step's distance along the path.
+pub(super) fn follow_observed(
+    solver: &StaticSolver,
+    start: State,
+    lambda0: f64,
+    settings: &StaticSettings,
+    observe: &mut dyn FnMut(&State, f64, f64),
+) -> StaticSolution {
     let clock = Instant::now();
     let system = solver.system();
     let f_hat = reference_load(solver, system);
@@ -202,6 +215,7 @@ pub(super) fn follow(
         previous = Some(increment);
         state = trial;
         lambda = trial_lambda;
+        observe(&state, lambda, dl);
         lambda_max = lambda_max.max(lambda);
         steps.push(StepRecord {
             load_factor: lambda,

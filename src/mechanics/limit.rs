@@ -11,7 +11,7 @@ use super::assembly::State;
 use super::model::{MechanicsError, NodalLoad};
 use super::settings::{PathControl, StaticSettings, StaticTermination};
 use super::solver::StaticSolver;
-use super::stability::Mode;
+use super::stability::{Mode, Stability};
 
 /// What bounds the limit load from above.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -28,8 +28,10 @@ pub enum LimitBound {
     /// The path's load maximum (a limit point), passed by arc length: the
     /// path turns back there and the state it reaches beyond is certified
     /// unstable, so there is no equilibrium above it on this path. The
-    /// maximum is the largest load of the arc-length steps; the true one
-    /// lies above it by the steps' curvature error.
+    /// maximum is the vertex of the parabola through the highest arc-length
+    /// step and its two neighbours (load factor against arc length),
+    /// resampled with shorter steps until it is within the search's
+    /// precision of the highest stable step.
     LoadMaximum {
         /// The largest load factor on the path.
         load_factor: f64,
@@ -236,33 +238,47 @@ pub fn limit_load_factor(
         if search.stable_to >= search_to {
             break Ok(());
         }
-        let within =
-            |bound: f64| bound.is_finite() && bound - search.stable_to <= precision * bound;
-        if !arc_tried && failed_at < certified && within(failed_at) {
+        let within = |bound: f64, stable_to: f64| {
+            bound.is_finite() && bound - stable_to <= precision * bound
+        };
+        if !arc_tried && failed_at < certified && within(failed_at, search.stable_to) {
             arc_tried = true;
             // Load control fails just above a stable state: a load maximum,
             // or Newton's failure. Arc length tells which; below a maximum
-            // the failures were Newton's, and bisection goes on up to it.
+            // the failures were Newton's, and its highest step, if stable,
+            // is the last stable state.
             let found = load_maximum(
                 solver,
                 &loads,
                 failed_at,
                 &stable_state,
                 search.stable_to,
+                precision,
                 settings,
             );
             match found {
                 Ok(Some(p)) => {
-                    peak = p;
+                    peak = p.estimate;
                     failed_at = f64::INFINITY;
-                    continue;
+                    search.solves += 1;
+                    if p.stability.stable && p.load_factor > search.stable_to {
+                        search.stable_to = p.load_factor;
+                        search
+                            .path
+                            .push([p.load_factor, p.stability.lowest_stiffness_n_per_m]);
+                        search.mode = p.stability.mode;
+                        stable_state = p.state;
+                    }
+                    search.newton_iterations += p.newton_iterations;
                 }
                 Ok(None) => {}
                 Err(e) => break Err(e),
             }
         }
         let certified = unstable_from.min(peak);
-        let done = within(certified) || within(failed_at) || search.solves >= MAX_SOLVES;
+        let done = within(certified, search.stable_to)
+            || within(failed_at, search.stable_to)
+            || search.solves >= MAX_SOLVES;
         if done {
             // The certified bound if there is one, else the failed load.
             search.bound = if unstable_from.is_finite() && unstable_from <= peak {
@@ -305,40 +321,148 @@ fn next_trial(path: &[[f64; 2]], search_to: f64, precision: f64) -> f64 {
     trial.min(search_to)
 }
 
-/// Loads beyond `failed_at` by this fraction are the arc length's target:
-/// far enough that it passes a load maximum just above `failed_at` before it
-/// would land.
+/// Loads beyond the first failed load by this fraction are the arc
+/// length's target: far enough that it passes a load maximum just above
+/// that load before it would land.
 const ARC_TARGET_MARGIN: f64 = 0.05;
 
+/// Arc-length runs that resample a load maximum with shorter steps.
+const PEAK_REFINEMENTS: usize = 4;
+
+/// Steps before the highest one tested for stability when the highest one
+/// has passed the maximum.
+const MAX_PAST_MAXIMUM: usize = 3;
+
+/// A load maximum of the path, passed by arc length.
+struct Peak {
+    /// The converged step of highest load factor that is stable.
+    state: State,
+    /// Its load factor.
+    load_factor: f64,
+    /// Its stability.
+    stability: Stability,
+    /// Newton iterations of the arc-length runs.
+    newton_iterations: usize,
+    /// The vertex of the parabola through that step and its neighbours
+    /// along the path, in load factor against arc length: the maximum's
+    /// estimate, at least `load_factor`.
+    estimate: f64,
+}
+
 /// The path's load maximum above `start` (an equilibrium at `start_lambda` ×
-/// `loads`), when arc length towards `failed_at` passes one and the state it
-/// reaches beyond is certified unstable; `None` when it does not (it stalls,
-/// or the path goes on, the load-control failure having been Newton's).
+/// `loads`), when arc length towards `beyond` passes one and the state it
+/// reaches past it is certified unstable; `None` when it does not (it
+/// stalls, or the path goes on, the load-control failure having been
+/// Newton's). The maximum is resampled from the step before it with shorter
+/// steps until the parabola's vertex is within `precision` of the highest
+/// step.
 fn load_maximum(
     solver: &mut StaticSolver,
     loads: &[NodalLoad],
-    failed_at: f64,
+    beyond: f64,
     start: &State,
     start_lambda: f64,
+    precision: f64,
     settings: &StaticSettings,
-) -> Result<Option<f64>, MechanicsError> {
-    let target = failed_at * (1.0 + ARC_TARGET_MARGIN);
+) -> Result<Option<Peak>, MechanicsError> {
+    let target = beyond * (1.0 + ARC_TARGET_MARGIN);
+    set_scaled_loads(solver, loads, target)?;
     // A first step of about a quarter of the gap to the failed load, cut at
     // most to a thousandth of that.
-    let first = 0.25 * (failed_at - start_lambda).max(1e-3 * failed_at) / target;
-    let arc = StaticSettings {
-        path: PathControl::ArcLength,
-        initial_step: first,
-        min_step: 1e-3 * first,
-        ..settings.clone()
-    };
-    set_scaled_loads(solver, loads, target)?;
-    let solution = solver.solve_from(start.clone(), start_lambda / target, &arc)?;
-    let StaticTermination::LimitPoint { limit_load_factor } = solution.termination else {
-        return Ok(None);
-    };
-    let beyond = solver.stability(&solution.state, solution.load_factor)?;
-    Ok((!beyond.stable).then_some(limit_load_factor * target))
+    let mut first = 0.25 * (beyond - start_lambda).max(1e-3 * beyond) / target;
+    let mut from = (start.clone(), start_lambda);
+    let mut found: Option<Peak> = None;
+    let mut newton_iterations = 0;
+    for _ in 0..PEAK_REFINEMENTS {
+        let arc = StaticSettings {
+            path: PathControl::ArcLength,
+            initial_step: first,
+            min_step: 1e-3 * first,
+            ..settings.clone()
+        };
+        // Every converged step: (arc length so far, load factor, state).
+        let mut steps: Vec<(f64, f64, State)> = vec![(0.0, from.1, from.0.clone())];
+        let mut travelled = 0.0;
+        let solution = super::arc_length::follow_observed(
+            solver,
+            from.0.clone(),
+            from.1 / target,
+            &arc,
+            &mut |state, lambda, dl| {
+                travelled += dl;
+                steps.push((travelled, lambda * target, state.clone()));
+            },
+        );
+        newton_iterations += solution.newton_iterations;
+        if !matches!(solution.termination, StaticTermination::LimitPoint { .. })
+            || solver
+                .stability(&solution.state, solution.load_factor)?
+                .stable
+        {
+            break;
+        }
+        let top = (0..steps.len())
+            .max_by(|&a, &b| steps[a].1.total_cmp(&steps[b].1))
+            .expect("the start is a step");
+        let estimate = match (top.checked_sub(1), steps.get(top + 1)) {
+            (Some(before), Some(after)) => {
+                parabola_vertex([&steps[before], &steps[top], after].map(|s| [s.0, s.1]))
+            }
+            _ => steps[top].1,
+        }
+        .max(steps[top].1);
+        // The highest stable step: the top one, or one of the few before
+        // it when the top has passed the maximum already.
+        let mut highest_stable = None;
+        for i in (top.saturating_sub(MAX_PAST_MAXIMUM)..=top).rev() {
+            let stability = solver.stability(&steps[i].2, steps[i].1 / target)?;
+            if stability.stable {
+                highest_stable = Some((i, stability));
+                break;
+            }
+        }
+        let Some((i, stability)) = highest_stable else {
+            break;
+        };
+        let (_, load_factor, state) = steps.swap_remove(i);
+        // Resample from there, a quarter of the way to the estimate first.
+        first = 0.25 * (estimate - load_factor).max(1e-6 * load_factor) / target;
+        from = (state.clone(), load_factor);
+        found = Some(Peak {
+            state,
+            load_factor,
+            stability,
+            newton_iterations: 0,
+            estimate,
+        });
+        if estimate - load_factor <= precision * estimate {
+            break;
+        }
+    }
+    Ok(found.map(|p| Peak {
+        newton_iterations,
+        ..p
+    }))
+}
+
+/// The largest value of the parabola through three points `[x, y]`, or the
+/// largest `y` when they are not concave.
+fn parabola_vertex(points: [[f64; 2]; 3]) -> f64 {
+    let [[x0, y0], [x1, y1], [x2, y2]] = points;
+    let d1 = (y1 - y0) / (x1 - x0);
+    let d2 = (y2 - y1) / (x2 - x1);
+    let c = (d2 - d1) / (x2 - x0);
+    let largest = y0.max(y1).max(y2);
+    if !(c < 0.0) {
+        return largest;
+    }
+    let x = 0.5 * (x0 + x1) - d1 / (2.0 * c);
+    let vertex = y0 + d1 * (x - x0) + c * (x - x0) * (x - x1);
+    if vertex.is_finite() {
+        vertex.max(largest)
+    } else {
+        largest
+    }
 }
 
 /// How far a solve towards a load factor got.
