@@ -453,7 +453,7 @@ fn parabola_vertex(points: [[f64; 2]; 3]) -> f64 {
     let d2 = (y2 - y1) / (x2 - x1);
     let c = (d2 - d1) / (x2 - x0);
     let largest = y0.max(y1).max(y2);
-    if !(c < 0.0) {
+    if c.is_nan() || c >= 0.0 {
         return largest;
     }
     let x = 0.5 * (x0 + x1) - d1 / (2.0 * c);
