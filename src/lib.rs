@@ -44,6 +44,7 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod shard;
+pub mod sizing;
 pub mod study;
 pub mod truss;
 pub mod uniformity;
@@ -86,6 +87,9 @@ pub enum Error {
     /// The accuracy study cannot run.
     #[error(transparent)]
     Study(#[from] study::StudyError),
+    /// A truss that cannot be sized.
+    #[error(transparent)]
+    Sizing(#[from] sizing::SizingError),
     /// A bad shard, or shards that cannot be merged.
     #[error(transparent)]
     Shard(#[from] shard::ShardError),
@@ -105,6 +109,7 @@ impl Error {
             Error::Design(e) => e.is_bad_input(),
             Error::Study(e) => e.is_bad_input(),
             Error::Shard(e) => e.is_bad_input(),
+            Error::Sizing(e) => e.is_bad_input(),
             Error::Verify(e) => matches!(
                 e,
                 verify::VerifyError::Mechanics(mechanics::MechanicsError::Invalid { .. })

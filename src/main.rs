@@ -94,6 +94,36 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Size the ring truss: the lightest tube section whose design (the whole
+    /// outer loop on the exact truss, as `design`) has a limit margin of at
+    /// least --margin.
+    ///
+    /// With --sections, the catalogue's sections (CSV: outer_diameter_m,
+    /// inner_diameter_m[,youngs_modulus_pa,density_kg_per_m3]; see
+    /// problems/carbon-tubes.csv) are searched by bisection, lightest first;
+    /// without, the outer diameter at the scene's d/D and material. Every rod
+    /// gets the section. Writes sizing.csv (every section tried: mass, margin,
+    /// outer iterations, RMS as built) and <scene>-sized.toml; one line per
+    /// section on stderr.
+    ///
+    /// Example: ringmesh size problems/paper-26m.toml --margin 2 --sections problems/carbon-tubes.csv
+    Size {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// The limit margin to reach: the multiple of the design's pull the
+        /// truss must carry stably (1 … 4).
+        #[arg(long, default_value_t = 2.0)]
+        margin: f64,
+        /// A catalogue of tube sections (CSV) [default: any outer diameter].
+        #[arg(long)]
+        sections: Option<PathBuf>,
+        /// The uniformity solver.
+        #[arg(long, value_enum, default_value = "lp")]
+        solver: SolverKind,
+        /// Output folder [default: results/<scene name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// One tension-uniformity design for the scene's theoretical (rigid) boundary.
     ///
     /// Writes design.json (q, tensions, positions, ratio per set and group, surface
@@ -411,6 +441,39 @@ fn main() -> ExitCode {
                 }
             })
         }
+        Command::Size {
+            scene,
+            margin,
+            sections,
+            solver,
+            output,
+        } => {
+            let settings = ringmesh::design::DesignSettings {
+                solver: *solver,
+                ..Default::default()
+            };
+            ringmesh::run::size(
+                scene,
+                *margin,
+                sections.as_deref(),
+                &settings,
+                output.as_deref(),
+                &mut |t| eprintln!("{}", section_line(t)),
+            )
+            .map(|outcome| {
+                let s = &outcome.sizing;
+                let chosen = &s.trials[s.chosen];
+                say!(
+                    "lightest section with a margin ≥ {} of {} tried: {}",
+                    s.margin,
+                    s.trials.len(),
+                    section_line(chosen)
+                );
+                for path in &outcome.written {
+                    say!("wrote {}", path.display());
+                }
+            })
+        }
         Command::Optimize {
             scene,
             solver,
@@ -634,6 +697,37 @@ fn main() -> ExitCode {
             ExitCode::from(if error.is_bad_input() { 2 } else { 1 })
         }
     }
+}
+
+/// One section a sizing tried, on one line.
+fn section_line(t: &ringmesh::sizing::SectionTrial) -> String {
+    let c = &t.section;
+    let outcome = match (&t.failure, t.rms_mm) {
+        (Some(f), _) => format!("no design: {f}"),
+        (None, Some(rms)) => format!(
+            "{} outer iterations, RMS as built {rms:.2e} mm",
+            t.outer_iterations
+        ),
+        (None, None) => String::new(),
+    };
+    format!(
+        "{:.1}/{:.1} mm tube: {:.0} kg, margin {:.3}{}, {}; {outcome} ({:.1} s)",
+        1e3 * c.outer_diameter_m,
+        1e3 * c.inner_diameter_m,
+        t.mass_kg,
+        t.margin,
+        if t.bound == Some(ringmesh::mechanics::LimitBound::SearchEnd) {
+            " (searched to its end)"
+        } else {
+            ""
+        },
+        if t.carries {
+            "carries"
+        } else {
+            "does not carry"
+        },
+        t.time_s
+    )
 }
 
 /// One paragraph: size, how the solve ended, and its largest results.

@@ -106,6 +106,19 @@ impl std::fmt::Display for LimitSearch {
     }
 }
 
+impl LimitBound {
+    /// The bound's kind, as `design.json` names it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            LimitBound::SearchEnd => "search_end",
+            LimitBound::Unstable { .. } => "unstable",
+            LimitBound::LoadMaximum { .. } => "load_maximum",
+            LimitBound::NotReached { .. } => "not_reached",
+            LimitBound::Budget => "budget",
+        }
+    }
+}
+
 impl LimitSearch {
     /// The margin to the limit load: the load factor certified stable.
     pub fn margin(&self) -> f64 {
@@ -617,6 +630,20 @@ mod tests {
             "margin {}, expected {expected}: {search:?}",
             search.margin()
         );
+    }
+
+    #[test]
+    fn a_bounds_kind_is_its_json_tag() {
+        for bound in [
+            LimitBound::SearchEnd,
+            LimitBound::Unstable { load_factor: 1.0 },
+            LimitBound::LoadMaximum { load_factor: 1.0 },
+            LimitBound::NotReached { load_factor: 1.0 },
+            LimitBound::Budget,
+        ] {
+            let json = serde_json::to_value(bound).unwrap();
+            assert_eq!(json["kind"], bound.kind(), "{bound:?}");
+        }
     }
 
     #[test]

@@ -6,6 +6,7 @@ use std::fmt::Write;
 use crate::design::{LoopRun, LoopTermination};
 use crate::network::Network;
 use crate::scene::{Cables, TrussModel};
+use crate::sizing::SectionTrial;
 use crate::study::{value_name, Knob, RunSettings, StudyRow};
 use crate::uniformity::{Design, FrontPoint, SolverKind};
 
@@ -304,6 +305,36 @@ impl RowError {
             expected,
         }
     }
+}
+
+/// `outer_diameter_m,…`: one row per section a sizing tried, in the order
+/// tried; missing numbers are empty.
+pub fn sizing_csv(trials: &[SectionTrial]) -> String {
+    let mut s = String::from(
+        "outer_diameter_m,inner_diameter_m,youngs_modulus_pa,density_kg_per_m3,mass_kg,margin,\
+         bound,outer_iterations,termination,rms_mm,carries,time_s,failure\n",
+    );
+    for t in trials {
+        let c = &t.section;
+        let _ = writeln!(
+            s,
+            "{},{},{:e},{},{:.6e},{:.6},{},{},{},{},{},{:.3},{}",
+            c.outer_diameter_m,
+            c.inner_diameter_m,
+            c.youngs_modulus_pa,
+            c.density_kg_per_m3,
+            t.mass_kg,
+            t.margin,
+            t.bound.map_or("", |b| b.kind()),
+            t.outer_iterations,
+            t.termination.map_or(String::new(), termination_name),
+            t.rms_mm.map_or(String::new(), |v| format!("{v:.6e}")),
+            t.carries,
+            t.time_s,
+            t.failure.as_deref().map_or(String::new(), quote),
+        );
+    }
+    s
 }
 
 /// `relaxation,iteration,…`: one row per outer iteration of every run.

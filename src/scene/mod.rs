@@ -400,6 +400,18 @@ impl Scene {
         Ok(scene)
     }
 
+    /// The scene as TOML text that [`Scene::from_toml`] reads back to an
+    /// equal scene (a table the effects name stays a file name).
+    ///
+    /// # Errors
+    /// A value TOML cannot hold (not one of a validated scene).
+    pub fn to_toml(&self) -> Result<String, SceneError> {
+        toml::to_string(self).map_err(|e| SceneError::Parse {
+            path: format!("<scene {}>", self.name),
+            message: e.to_string(),
+        })
+    }
+
     /// Reads the tables the effects name (only those asked for).
     fn read_effect_files(&mut self, folder: &Path) -> Result<(), SceneError> {
         if let Some(file) = &self.effects.rod_properties_csv {
