@@ -124,6 +124,31 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// The aperture study: how much the flexible-truss design matters as the
+    /// dish grows.
+    ///
+    /// For each aperture the scene is scaled (F/D, facet size and membrane
+    /// stress kept, bays kept, every truss length grown with the aperture),
+    /// its tube sized for --margin as `size` does (outer diameter at the
+    /// scene's d/D), and the conventional (rigid-truss), linear-truss and
+    /// exact-truss designs are each assembled on the exact truss. Writes
+    /// apertures.csv/.json/.png/.svg and each aperture's sized scene
+    /// (<scene>-at-<D>m.toml); one line per aperture on stderr.
+    ///
+    /// Example: ringmesh apertures problems/paper-26m.toml --apertures 26,40,60,80,100
+    Apertures {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// The apertures, m, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "26,40,60,80,100")]
+        apertures: Vec<f64>,
+        /// The limit margin each truss is sized for (1 … 4).
+        #[arg(long, default_value_t = 2.0)]
+        margin: f64,
+        /// Output folder [default: results/<scene name>/apertures].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// One tension-uniformity design for the scene's theoretical (rigid) boundary.
     ///
     /// Writes design.json (q, tensions, positions, ratio per set and group, surface
@@ -421,10 +446,7 @@ fn main() -> ExitCode {
                      writing {:.2}",
                     t.total_s,
                     t.mesh_s,
-                    t.truss_setup_s
-                        + t.uniformity_s.iter().sum::<f64>()
-                        + t.truss_s.iter().sum::<f64>()
-                        + t.loop_other_s,
+                    t.design_loop_s(),
                     t.uniformity_s.iter().sum::<f64>(),
                     t.truss_s.iter().sum::<f64>(),
                     t.comparison_loops_s,
@@ -435,6 +457,29 @@ fn main() -> ExitCode {
                 );
                 for w in &r.net.warnings {
                     say!("warning: {w}");
+                }
+                for path in &outcome.written {
+                    say!("wrote {}", path.display());
+                }
+            })
+        }
+        Command::Apertures {
+            scene,
+            apertures,
+            margin,
+            output,
+        } => {
+            let settings = ringmesh::study::ApertureSettings {
+                apertures_m: apertures.clone(),
+                margin: *margin,
+                design: Default::default(),
+            };
+            ringmesh::run::apertures(scene, &settings, output.as_deref(), &mut |r| {
+                eprintln!("{}", aperture_line(r))
+            })
+            .map(|outcome| {
+                for r in &outcome.results {
+                    say!("{}", aperture_line(r));
                 }
                 for path in &outcome.written {
                     say!("wrote {}", path.display());
@@ -697,6 +742,35 @@ fn main() -> ExitCode {
             ExitCode::from(if error.is_bad_input() { 2 } else { 1 })
         }
     }
+}
+
+/// One aperture of the aperture study, on one line.
+fn aperture_line(r: &ringmesh::study::ApertureResult) -> String {
+    let models: Vec<String> = r
+        .models
+        .iter()
+        .map(|m| {
+            format!(
+                "{} {:.2e} mm / {:.2e} %",
+                ringmesh::study::value_name(&m.model),
+                m.rms_mm,
+                m.tension_change_pct
+            )
+        })
+        .collect();
+    format!(
+        "{} m: {} rings, {:.1}/{:.1} mm tube ({:.0} kg, margin {:.3}), hinges move {:.1} mm; \
+         RMS / tension change as built: {} ({:.0} s sizing)",
+        r.aperture_m,
+        r.rings,
+        1e3 * r.section.outer_diameter_m,
+        1e3 * r.section.inner_diameter_m,
+        r.truss_mass_kg,
+        r.margin,
+        r.hinge_motion_mm,
+        models.join(", "),
+        r.sizing_time_s
+    )
 }
 
 /// One section a sizing tried, on one line.

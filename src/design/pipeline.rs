@@ -115,6 +115,14 @@ impl Timings {
             - self.truss_s.iter().sum::<f64>();
     }
 
+    /// The design loop's wall time with its truss's set-up, s.
+    pub fn design_loop_s(&self) -> f64 {
+        self.truss_setup_s
+            + self.uniformity_s.iter().sum::<f64>()
+            + self.truss_s.iter().sum::<f64>()
+            + self.loop_other_s
+    }
+
     /// The sum of the stages, s (`total_s` less what no stage measured).
     pub fn stages_s(&self) -> f64 {
         self.read_s
@@ -183,6 +191,9 @@ pub struct DesignRun {
     pub mesh: ReflectorMesh,
     /// The network at the design's geometry (the final boundary `C`).
     pub network: Network,
+    /// The conventional design (the loop's iteration 0), when the truss
+    /// deforms: the one `report.conventional` assembles.
+    pub conventional_net: Option<Design>,
 }
 
 /// The outer design loop (net design ⇄ truss response) of `scene` with each
@@ -306,6 +317,10 @@ pub fn run(
     let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
     // undeformed attachment points.
+    let conventional_net = match assembly {
+        AssemblyTruss::Rigid => None,
+        AssemblyTruss::Flexible => Some(outcome.initial.design.clone()),
+    };
     let conventional = match assembly {
         AssemblyTruss::Rigid => None,
         AssemblyTruss::Flexible => Some(verify(
@@ -342,6 +357,7 @@ pub fn run(
         report,
         mesh: scene_nets.mesh,
         network,
+        conventional_net,
     })
 }
 

@@ -7,7 +7,7 @@ use crate::design::{LoopRun, LoopTermination};
 use crate::network::Network;
 use crate::scene::{Cables, TrussModel};
 use crate::sizing::SectionTrial;
-use crate::study::{value_name, Knob, RunSettings, StudyRow};
+use crate::study::{value_name, ApertureResult, Knob, RunSettings, StudyRow};
 use crate::uniformity::{Design, FrontPoint, SolverKind};
 
 /// `id,group,i,j,q,tension_n,length_m,cut_length_m`: one row per cable, with the
@@ -333,6 +333,49 @@ pub fn sizing_csv(trials: &[SectionTrial]) -> String {
             t.time_s,
             t.failure.as_deref().map_or(String::new(), quote),
         );
+    }
+    s
+}
+
+/// `aperture_m,…`: one row per aperture and design model (rigid, linear,
+/// exact), the aperture's figures repeated on each.
+pub fn aperture_csv(results: &[ApertureResult]) -> String {
+    let mut s = String::from(
+        "aperture_m,rings,nodes,outer_diameter_m,inner_diameter_m,truss_mass_kg,margin,\
+         sizing_designs,sizing_time_s,hinge_motion_mm,model,outer_iterations,ratio,built_ratio,\
+         rms_mm,max_deviation_mm,tension_change_pct,cut_length_error_mm,boundary_deviation_mm,\
+         slack_cables,design_time_s,assembly_time_s\n",
+    );
+    for r in results {
+        for m in &r.models {
+            let _ = writeln!(
+                s,
+                "{},{},{},{},{},{:.6e},{:.6},{},{:.3},{:.6e},{},{},{:.10e},{:.10e},{:.6e},{:.6e},\
+                 {:.6e},{:.6e},{:.6e},{},{:.3},{:.3}",
+                r.aperture_m,
+                r.rings,
+                r.nodes,
+                r.section.outer_diameter_m,
+                r.section.inner_diameter_m,
+                r.truss_mass_kg,
+                r.margin,
+                r.sizing_designs,
+                r.sizing_time_s,
+                r.hinge_motion_mm,
+                value_name(&m.model),
+                m.outer_iterations,
+                m.ratio,
+                m.built_ratio,
+                m.rms_mm,
+                m.max_deviation_mm,
+                m.tension_change_pct,
+                m.cut_length_error_mm,
+                m.boundary_deviation_mm,
+                m.slack_cables,
+                m.design_time_s,
+                m.assembly_time_s,
+            );
+        }
     }
     s
 }

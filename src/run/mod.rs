@@ -4,6 +4,7 @@
 //! the pipelines themselves live in the library ([`crate::design::run`],
 //! [`crate::study::run_study`], …).
 
+mod apertures;
 mod cantilever;
 mod design;
 mod fdm;
@@ -19,6 +20,7 @@ mod uniformity;
 
 use std::path::{Path, PathBuf};
 
+pub use apertures::{apertures, AperturesOutcome};
 pub use cantilever::{cantilever, CantileverTable, CantileverTableRow};
 pub use design::{design, DesignOutcome};
 pub use fdm::{fdm, FdmOutput};

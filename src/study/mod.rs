@@ -41,6 +41,7 @@
 //! ([`crate::shard`]); every shard runs the reference itself to judge its
 //! points.
 
+mod aperture;
 mod pareto;
 
 use std::time::Instant;
@@ -48,6 +49,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+pub use aperture::{
+    run_aperture_study, scaled, ApertureResult, ApertureSettings, ModelResult, MAX_APERTURE_M,
+};
 pub use pareto::pareto_optimal;
 
 use crate::design::SceneNets;
@@ -506,16 +510,7 @@ fn measure(
             .problem
             .sets()
             .iter()
-            .map(|set| {
-                let (lo, hi) = set
-                    .edges
-                    .iter()
-                    .map(|&k| v.tensions_n[k])
-                    .fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
-                        (lo.min(t), hi.max(t))
-                    });
-                hi / lo
-            })
+            .map(|set| set.ratio(&v.tensions_n))
             .fold(0.0, f64::max);
         let cut_lengths_m = design
             .lengths_m

@@ -21,6 +21,20 @@ pub struct UniformitySet {
     pub mean_tension_n: f64,
 }
 
+impl UniformitySet {
+    /// `Tmax/Tmin` of `tensions_n` (all cables) over the set's cables.
+    pub fn ratio(&self, tensions_n: &[f64]) -> f64 {
+        let (lo, hi) = self
+            .edges
+            .iter()
+            .map(|&k| tensions_n[k])
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
+                (lo.min(t), hi.max(t))
+            });
+        hi / lo
+    }
+}
+
 /// What the surface accuracy of a design is measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SurfaceTarget {
