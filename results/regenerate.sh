@@ -14,3 +14,9 @@ done
 "$ringmesh" front problems/paper-26m.toml
 "$ringmesh" study problems/paper-26m.toml
 "$ringmesh" study problems/realistic-26m.toml
+# The tube of paper-26m sized for a margin of 2, from the shipped catalogue
+# (sizing.csv, paper-26m-sized.toml), and the aperture study at the paper's
+# F/D (0.154) and at a shallow one (realistic-26m, 0.6): results/<scene>/apertures/.
+"$ringmesh" size problems/paper-26m.toml --margin 2 --sections problems/carbon-tubes.csv
+"$ringmesh" apertures problems/paper-26m.toml --apertures 26,40,60,80,100
+"$ringmesh" apertures problems/realistic-26m.toml --apertures 26,40,60,80,100

@@ -318,7 +318,7 @@ pub fn sizing_csv(trials: &[SectionTrial]) -> String {
         let c = &t.section;
         let _ = writeln!(
             s,
-            "{},{},{:e},{},{:.6e},{:.6},{},{},{},{},{},{:.3},{}",
+            "{:.7},{:.7},{:e},{},{:.6e},{:.6},{},{},{},{},{},{:.3},{}",
             c.outer_diameter_m,
             c.inner_diameter_m,
             c.youngs_modulus_pa,
@@ -350,8 +350,8 @@ pub fn aperture_csv(results: &[ApertureResult]) -> String {
         for m in &r.models {
             let _ = writeln!(
                 s,
-                "{},{},{},{},{},{:.6e},{:.6},{},{:.3},{:.6e},{},{},{:.10e},{:.10e},{:.6e},{:.6e},\
-                 {:.6e},{:.6e},{:.6e},{},{:.3},{:.3}",
+                "{},{},{},{:.7},{:.7},{:.6e},{:.6},{},{:.3},{:.6e},{},{},{:.10e},{},{:.6e},\
+                 {:.6e},{:.6e},{:.6e},{:.6e},{},{:.3},{:.3}",
                 r.aperture_m,
                 r.rings,
                 r.nodes,
@@ -365,7 +365,7 @@ pub fn aperture_csv(results: &[ApertureResult]) -> String {
                 value_name(&m.model),
                 m.outer_iterations,
                 m.ratio,
-                m.built_ratio,
+                finite(m.built_ratio),
                 m.rms_mm,
                 m.max_deviation_mm,
                 m.tension_change_pct,
@@ -378,6 +378,15 @@ pub fn aperture_csv(results: &[ApertureResult]) -> String {
         }
     }
     s
+}
+
+/// A number, or nothing when it is not finite.
+fn finite(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.10e}")
+    } else {
+        String::new()
+    }
 }
 
 /// `relaxation,iteration,…`: one row per outer iteration of every run.

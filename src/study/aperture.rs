@@ -103,7 +103,8 @@ pub struct ModelResult {
     pub outer_iterations: usize,
     /// The design's `Tmax/Tmin` (the largest over the uniformity sets).
     pub ratio: f64,
-    /// The same of the assembled tensions.
+    /// The same of the assembled tensions (infinite, empty in the CSV and
+    /// null in the JSON, when a cable of a set is slack).
     pub built_ratio: f64,
     /// Surface RMS as built, mm.
     pub rms_mm: f64,
