@@ -173,7 +173,8 @@ const MAX_DESIGNS: usize = 16;
 /// # Errors
 /// A margin outside `[1, SEARCH_TO]`, a scene whose truss is measured rod
 /// by rod (`effects.rod_properties_csv`) or not exact, an invalid section,
-/// or no section that carries ([`SizingError::NoSection`]).
+/// a design that fails for another reason than its truss (no tube would
+/// help), or no section that carries ([`SizingError::NoSection`]).
 pub fn size_truss(
     scene: &Scene,
     sections: &Sections,
@@ -293,14 +294,17 @@ impl Search<'_> {
                     report.termination == LoopTermination::Converged && trial.margin >= self.margin;
                 run = Some(r);
             }
-            Err(e @ Error::Scene(_)) => return Err(e),
-            Err(e) => {
-                if let Some(TrussError::PastLimitLoad { stable_to, bound }) = past_limit(&e) {
+            Err(e) => match truss_failure(&e) {
+                // The tube is too weak: this section does not carry.
+                Some(TrussError::PastLimitLoad { stable_to, bound }) => {
                     trial.margin = *stable_to;
                     trial.bound = Some(*bound);
+                    trial.failure = Some(e.to_string());
                 }
-                trial.failure = Some(e.to_string());
-            }
+                Some(TrussError::NoEquilibrium { .. }) => trial.failure = Some(e.to_string()),
+                // Not the tube's doing: no section would design.
+                _ => return Err(e),
+            },
         }
         (self.observe)(&trial);
         let carries = trial.carries;
@@ -400,12 +404,11 @@ impl Search<'_> {
     }
 }
 
-/// The truss's refusal of a pull past its limit load, inside `e`.
-fn past_limit(e: &Error) -> Option<&TrussError> {
-    let truss = match e {
-        Error::Truss(t) => t,
-        Error::Design(crate::design::DesignError::Truss { source, .. }) => source,
-        _ => return None,
-    };
-    matches!(truss, TrussError::PastLimitLoad { .. }).then_some(truss)
+/// The truss's failure inside `e`, if it is one.
+fn truss_failure(e: &Error) -> Option<&TrussError> {
+    match e {
+        Error::Truss(t) => Some(t),
+        Error::Design(crate::design::DesignError::Truss { source, .. }) => Some(source),
+        _ => None,
+    }
 }

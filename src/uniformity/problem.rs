@@ -22,7 +22,8 @@ pub struct UniformitySet {
 }
 
 impl UniformitySet {
-    /// `Tmax/Tmin` of `tensions_n` (all cables) over the set's cables.
+    /// `Tmax/Tmin` of `tensions_n` (all cables) over the set's cables:
+    /// infinite when one of them is slack (`T ≤ 0`).
     pub fn ratio(&self, tensions_n: &[f64]) -> f64 {
         let (lo, hi) = self
             .edges
@@ -31,7 +32,11 @@ impl UniformitySet {
             .fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
                 (lo.min(t), hi.max(t))
             });
-        hi / lo
+        if lo > 0.0 {
+            hi / lo
+        } else {
+            f64::INFINITY
+        }
     }
 }
 
@@ -348,5 +353,23 @@ impl UniformityProblem {
     pub fn surface_rms_m(&self, nodes: &[[f64; 3]]) -> f64 {
         let e = self.surface_errors_m(nodes);
         (e.iter().map(|v| v * v).sum::<f64>() / e.len().max(1) as f64).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::UniformitySet;
+
+    #[test]
+    fn a_set_with_a_slack_cable_has_no_finite_ratio() {
+        let set = UniformitySet {
+            name: "front".into(),
+            edges: vec![0, 2],
+            mean_tension_n: 1.0,
+        };
+        assert_eq!(set.ratio(&[2.0, 100.0, 5.0]), 2.5);
+        // A slack cable's tension: zero, or a roundoff below it.
+        assert_eq!(set.ratio(&[-2e-9, 100.0, 5.0]), f64::INFINITY);
+        assert_eq!(set.ratio(&[0.0, 100.0, 5.0]), f64::INFINITY);
     }
 }
