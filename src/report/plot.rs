@@ -528,16 +528,7 @@ where
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .label_style(("sans-serif", 14))
         .draw()?;
-    let models = [
-        (
-            TrussModel::Rigid,
-            "conventional (rigid truss)",
-            RED.to_rgba(),
-        ),
-        (TrussModel::Linear, "linear truss", BLUE.to_rgba()),
-        (TrussModel::Exact, "exact truss", BLACK.to_rgba()),
-    ];
-    for (model, name, colour) in models {
+    for (model, _, colour) in aperture_models() {
         let points: Vec<(f64, f64)> = results
             .iter()
             .filter_map(|r| {
@@ -545,26 +536,27 @@ where
                 Some((r.aperture_m, value(m)))
             })
             .collect();
-        chart
-            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
-            .label(name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+        chart.draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?;
         chart.draw_series(
             points
                 .into_iter()
                 .map(|p| Circle::new(p, 4, colour.filled())),
         )?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::MiddleRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()?;
     Ok(())
+}
+
+/// The aperture study's design models: name and colour.
+fn aperture_models() -> [(TrussModel, &'static str, RGBAColor); 3] {
+    [
+        (
+            TrussModel::Rigid,
+            "conventional (rigid truss)",
+            RED.to_rgba(),
+        ),
+        (TrussModel::Linear, "linear truss", BLUE.to_rgba()),
+        (TrussModel::Exact, "exact truss", BLACK.to_rgba()),
+    ]
 }
 
 fn draw_apertures<DB: DrawingBackend>(
@@ -577,7 +569,20 @@ where
 {
     root.fill(&WHITE)?;
     let body = root.titled(title, ("sans-serif", 22))?;
-    let panels = body.split_evenly((1, 2));
+    let height = body.dim_in_pixel().1 as i32;
+    let (charts, legend) = body.split_vertically(height - 35);
+    let panels = charts.split_evenly((1, 2));
+    // The legend below the panels: the lines cross every part of them.
+    let font = ("sans-serif", 15).into_font();
+    let mut x = 90;
+    for (_, name, colour) in aperture_models() {
+        legend.draw(&PathElement::new(
+            vec![(x, 15), (x + 25, 15)],
+            colour.stroke_width(2),
+        ))?;
+        legend.draw(&Text::new(name, (x + 32, 7), font.clone()))?;
+        x += 60 + 9 * name.len() as i32;
+    }
     draw_aperture_panel(
         &panels[0],
         results,
