@@ -157,6 +157,8 @@ pub struct DesignReport {
     pub outer_iterations: usize,
     /// Final fixed-point residual `‖G(C) − C‖∞`, m.
     pub boundary_residual_m: f64,
+    /// The loop's stopping tolerance on it, m.
+    pub tolerance_m: f64,
     /// The design's largest set ratio `Tmax/Tmin`.
     pub ratio: f64,
     /// Wall time of the whole run (every loop, verifications), s.
@@ -342,6 +344,7 @@ pub fn run(
         termination: outcome.termination,
         outer_iterations: outcome.history.len(),
         boundary_residual_m: outcome.boundary_residual_m(),
+        tolerance_m: settings.tolerance_m,
         ratio: outcome.design.ratio,
         time_s: clock.elapsed().as_secs_f64(),
         history: outcome.history.clone(),

@@ -15,7 +15,9 @@ pub use csv::{
     aperture_csv, cables_csv, convergence_csv, front_csv, front_row, parse_front_row,
     parse_study_row, sizing_csv, study_csv, study_row, FrontRow, FRONT_COLUMNS, STUDY_COLUMNS,
 };
-pub use plot::{aperture_plot, convergence_plot, front_plot, study_plot, surface_plot};
+pub use plot::{
+    aperture_plot, convergence_plot, front_plot, study_plot, surface_plot, NodePanel, SurfaceFigure,
+};
 pub use vtk::{assembly_vtu, network_vtu};
 
 /// Writing a result failed.

@@ -134,6 +134,7 @@ fn draw_convergence<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     series: &[(String, Vec<(usize, f64)>)],
     title: &str,
+    tolerance_m: f64,
 ) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
@@ -141,7 +142,8 @@ where
     root.fill(&WHITE)?;
     let values = series
         .iter()
-        .flat_map(|(_, s)| s.iter().map(|p| p.1.max(RESIDUAL_FLOOR_M)));
+        .flat_map(|(_, s)| s.iter().map(|p| p.1.max(RESIDUAL_FLOOR_M)))
+        .chain(std::iter::once(tolerance_m.max(RESIDUAL_FLOOR_M)));
     let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
         (lo.min(v), hi.max(v))
     });
@@ -168,23 +170,48 @@ where
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .label_style(("sans-serif", 14))
         .draw()?;
+    // The tolerance, and each policy drawn thinner than the one before and
+    // with its own marker, so that one that follows another stays visible.
+    let tolerance = BLACK.stroke_width(2);
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(0, tolerance_m), (last.max(1), tolerance_m)],
+            8,
+            6,
+            tolerance,
+        ))?
+        .label(format!("tolerance {tolerance_m:.0e} m"))
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], tolerance));
     for (index, (name, points)) in series.iter().enumerate() {
         let colour = Palette99::pick(index).to_rgba();
+        let width = (4 - index.min(3) as u32).max(1);
         let points: Vec<(usize, f64)> = points
             .iter()
             .map(|&(k, v)| (k, v.max(RESIDUAL_FLOOR_M)))
             .collect();
         chart
-            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(width)))?
             .label(name.clone())
             .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(width))
             });
-        chart.draw_series(
-            points
-                .into_iter()
-                .map(|p| Circle::new(p, 3, colour.filled())),
-        )?;
+        match index % 3 {
+            0 => chart.draw_series(
+                points
+                    .into_iter()
+                    .map(|p| Circle::new(p, 5, colour.filled()).into_dyn()),
+            )?,
+            1 => chart.draw_series(
+                points
+                    .into_iter()
+                    .map(|p| TriangleMarker::new(p, 6, colour.filled()).into_dyn()),
+            )?,
+            _ => chart.draw_series(
+                points
+                    .into_iter()
+                    .map(|p| Cross::new(p, 5, colour.stroke_width(2)).into_dyn()),
+            )?,
+        };
     }
     chart
         .configure_series_labels()
@@ -196,84 +223,288 @@ where
 }
 
 /// Draws the outer loop's fixed-point residual per iteration (log scale, one
-/// line per relaxation policy) as PNG and SVG, each written atomically.
+/// line per relaxation policy, each with its own marker and width) with the
+/// stopping tolerance as PNG and SVG, each written atomically.
 pub fn convergence_plot(
     series: &[(String, Vec<(usize, f64)>)],
     title: &str,
+    tolerance_m: f64,
     png: &Path,
     svg: &Path,
 ) -> Result<(), ReportError> {
-    png_and_svg!(draw_convergence, (900, 600), png, svg, series, title)
+    png_and_svg!(
+        draw_convergence,
+        (900, 600),
+        png,
+        svg,
+        series,
+        title,
+        tolerance_m
+    )
 }
 
-/// Draws a top view of the surface nodes `(x, y, deviation_mm)`, coloured by
-/// the deviation (blue below the paraboloid, red above, white on it; the
-/// scale symmetric about zero), as a PNG written atomically.
-pub fn surface_plot(
-    points: &[(f64, f64, f64)],
-    title: &str,
-    png: &Path,
-) -> Result<(), ReportError> {
-    register_font();
-    let draw = |temporary: &Path| -> Result<(), DrawError> {
-        let root = BitMapBackend::new(temporary, (800u32, 800u32)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        let mut scale = 0.0f64;
-        for &(x, y, d) in points {
-            x_lo = x_lo.min(x);
-            x_hi = x_hi.max(x);
-            y_lo = y_lo.min(y);
-            y_hi = y_hi.max(y);
-            scale = scale.max(d.abs());
-        }
-        if !x_lo.is_finite() {
-            (x_lo, x_hi, y_lo, y_hi) = (-1.0, 1.0, -1.0, 1.0);
-        }
-        let pad = 0.05 * (x_hi - x_lo).max(y_hi - y_lo).max(1e-9);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(15)
-            .x_label_area_size(40)
-            .y_label_area_size(50)
-            .build_cartesian_2d((x_lo - pad)..(x_hi + pad), (y_lo - pad)..(y_hi + pad))?;
-        chart
-            .configure_mesh()
-            .x_desc(format!("x (m); colour: deviation, ±{scale:.2e} mm"))
-            .y_desc("y (m)")
-            .label_style(("sans-serif", 14))
-            .draw()?;
-        let colour = |d: f64| {
-            let t = if scale > 0.0 {
-                (d / scale).clamp(-1.0, 1.0)
-            } else {
-                0.0
-            };
-            let fade = |v: f64| (255.0 * (1.0 - v.abs())) as u8;
-            if t >= 0.0 {
-                RGBColor(255, fade(t), fade(t))
-            } else {
-                RGBColor(fade(t), fade(t), 255)
-            }
+/// One panel of the surface figure: the assembled front net's free nodes,
+/// `(x, y, deviation mm)`.
+#[derive(Debug, Clone)]
+pub struct NodePanel {
+    /// The panel's title.
+    pub title: String,
+    /// The nodes: plan position, m, and axial deviation from the paraboloid, mm.
+    pub nodes: Vec<(f64, f64, f64)>,
+}
+
+/// The surface figure of a design (issue 20): the designs as built side by
+/// side and the facet error of ours, on one signed colour scale in mm.
+#[derive(Debug, Clone)]
+pub struct SurfaceFigure {
+    /// The figure's title.
+    pub title: String,
+    /// Node panels, left to right (the conventional design as built, then
+    /// ours).
+    pub panels: Vec<NodePanel>,
+    /// The flat facets of our design as built: plan corners, m, and the
+    /// axial deviation of the facet's centroid from the paraboloid, mm.
+    pub facets: Vec<([(f64, f64); 3], f64)>,
+    /// The front net's cables in plan, m.
+    pub cables: Vec<[(f64, f64); 2]>,
+    /// The top hinges in plan, m, in ring order.
+    pub outline: Vec<(f64, f64)>,
+}
+
+/// A signed, symmetric logarithmic colour scale of deviations in mm: linear
+/// near zero (below `linear`), logarithmic beyond, so that the facets' error
+/// (millimetres), the conventional design's (tenths) and ours (roundoff) show
+/// on one bar.
+#[derive(Debug, Clone, Copy)]
+struct DeviationScale {
+    /// The largest magnitude, mm.
+    largest: f64,
+    /// Below this magnitude the scale is linear, mm.
+    linear: f64,
+}
+
+impl DeviationScale {
+    /// Decades shown below the largest magnitude.
+    const DECADES: f64 = 7.0;
+
+    fn of(largest: f64) -> Self {
+        let largest = if largest > 0.0 && largest.is_finite() {
+            largest
+        } else {
+            1.0
         };
+        DeviationScale {
+            largest,
+            linear: largest * 10f64.powf(-Self::DECADES),
+        }
+    }
+
+    /// Position of `d` on the bar, in `[-1, 1]`.
+    fn position(&self, d: f64) -> f64 {
+        let f = |m: f64| (1.0 + m / self.linear).ln();
+        (d.signum() * f(d.abs()) / f(self.largest)).clamp(-1.0, 1.0)
+    }
+
+    /// Red above the paraboloid (towards the focus), blue below, white on it.
+    fn colour(&self, d: f64) -> RGBColor {
+        let t = self.position(d);
+        let fade = |v: f64| (255.0 * (1.0 - v.abs())) as u8;
+        if t >= 0.0 {
+            RGBColor(255, fade(t), fade(t))
+        } else {
+            RGBColor(fade(t), fade(t), 255)
+        }
+    }
+}
+
+/// One plan-view panel: the truss outline, the cables, and either nodes or
+/// facets coloured by deviation.
+fn draw_surface_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    figure: &SurfaceFigure,
+    title: &str,
+    nodes: Option<&[(f64, f64, f64)]>,
+    scale: DeviationScale,
+) -> Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    let (mut lo, mut hi) = (
+        (f64::INFINITY, f64::INFINITY),
+        (f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
+    for &(x, y) in figure.outline.iter().chain(figure.cables.iter().flatten()) {
+        lo = (lo.0.min(x), lo.1.min(y));
+        hi = (hi.0.max(x), hi.1.max(y));
+    }
+    if !lo.0.is_finite() {
+        (lo, hi) = ((-1.0, -1.0), (1.0, 1.0));
+    }
+    let half = 0.55 * (hi.0 - lo.0).max(hi.1 - lo.1).max(1e-9);
+    let centre = (0.5 * (lo.0 + hi.0), 0.5 * (lo.1 + hi.1));
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 17))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(45)
+        .build_cartesian_2d(
+            (centre.0 - half)..(centre.0 + half),
+            (centre.1 - half)..(centre.1 + half),
+        )?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .label_style(("sans-serif", 13))
+        .draw()?;
+    if nodes.is_none() {
         chart.draw_series(
-            points
+            figure
+                .facets
                 .iter()
-                .map(|&(x, y, d)| Circle::new((x, y), 6, ShapeStyle::from(&colour(d)).filled())),
+                .map(|(corners, d)| Polygon::new(corners.to_vec(), scale.colour(*d).filled())),
+        )?;
+    }
+    let cable = RGBColor(120, 120, 120).stroke_width(1);
+    chart.draw_series(
+        figure
+            .cables
+            .iter()
+            .map(|c| PathElement::new(c.to_vec(), cable)),
+    )?;
+    if let Some(nodes) = nodes {
+        chart.draw_series(
+            nodes
+                .iter()
+                .map(|&(x, y, d)| Circle::new((x, y), 5, scale.colour(d).filled())),
         )?;
         chart.draw_series(
-            points
+            nodes
                 .iter()
-                .map(|&(x, y, _)| Circle::new((x, y), 6, BLACK.stroke_width(1))),
+                .map(|&(x, y, _)| Circle::new((x, y), 5, BLACK.stroke_width(1))),
         )?;
-        Ok(root.present()?)
-    };
-    write_atomic_with(png, draw)
+    }
+    let mut ring = figure.outline.clone();
+    ring.extend(figure.outline.first());
+    chart.draw_series(std::iter::once(PathElement::new(
+        ring,
+        BLACK.stroke_width(3),
+    )))?;
+    chart.draw_series(
+        figure
+            .outline
+            .iter()
+            .map(|&p| Rectangle::new([p, p], BLACK.stroke_width(6))),
+    )?;
+    Ok(())
+}
+
+/// The signed colour bar of `scale`, labelled at every decade.
+fn draw_colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    scale: DeviationScale,
+) -> Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(45)
+        .margin_bottom(45)
+        .margin_right(5)
+        .build_cartesian_2d(0.0..1.0, -1.0..1.0)?;
+    let steps = 400;
+    chart.draw_series((0..steps).map(|k| {
+        let a = -1.0 + 2.0 * k as f64 / steps as f64;
+        let b = a + 2.0 / steps as f64;
+        // The colour at the bar's position t is that of the deviation there.
+        let t = 0.5 * (a + b);
+        let f = |m: f64| (1.0 + m / scale.linear).ln();
+        let d = t.signum() * scale.linear * ((t.abs() * f(scale.largest)).exp() - 1.0);
+        Rectangle::new([(0.0, a), (0.25, b)], scale.colour(d).filled())
+    }))?;
+    let font = ("sans-serif", 13).into_font();
+    let top = scale.largest.log10().floor() as i32;
+    let mut labels = vec![(0.0, "0".to_string())];
+    for k in (top - DeviationScale::DECADES as i32 + 1)..=top {
+        let v = 10f64.powi(k);
+        labels.push((v, format!("+1e{k}")));
+        labels.push((-v, format!("−1e{k}")));
+    }
+    for (v, text) in labels {
+        let t = scale.position(v);
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(0.25, t), (0.32, t)],
+            BLACK.stroke_width(1),
+        )))?;
+        chart.draw_series(std::iter::once(Text::new(text, (0.36, t), font.clone())))?;
+    }
+    area.draw(&Text::new(
+        "mm (+ towards the focus)",
+        (0, 20),
+        ("sans-serif", 13).into_font(),
+    ))?;
+    Ok(())
+}
+
+fn draw_surface<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    figure: &SurfaceFigure,
+) -> Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let body = root.titled(&figure.title, ("sans-serif", 20))?;
+    let width = body.dim_in_pixel().0 as i32;
+    let (plots, bar) = body.split_horizontally(width - 170);
+    let scale = DeviationScale::of(
+        figure
+            .panels
+            .iter()
+            .flat_map(|p| p.nodes.iter().map(|n| n.2.abs()))
+            .chain(figure.facets.iter().map(|f| f.1.abs()))
+            .filter(|d| d.is_finite())
+            .fold(0.0, f64::max),
+    );
+    let areas = plots.split_evenly((1, figure.panels.len() + 1));
+    for (panel, area) in figure.panels.iter().zip(&areas) {
+        let rms = (panel.nodes.iter().map(|n| n.2 * n.2).sum::<f64>()
+            / panel.nodes.len().max(1) as f64)
+            .sqrt();
+        let title = format!("{}: node RMS {rms:.2e} mm", panel.title);
+        draw_surface_panel(area, figure, &title, Some(&panel.nodes), scale)?;
+    }
+    let facet_rms = (figure.facets.iter().map(|f| f.1 * f.1).sum::<f64>()
+        / figure.facets.len().max(1) as f64)
+        .sqrt();
+    draw_surface_panel(
+        &areas[figure.panels.len()],
+        figure,
+        &format!("flat facets of ours: centroid RMS {facet_rms:.2e} mm"),
+        None,
+        scale,
+    )?;
+    draw_colour_bar(&bar, scale)?;
+    Ok(root.present()?)
+}
+
+/// Draws the surface figure as a PNG written atomically: a plan view per
+/// design as built (nodes coloured by their axial deviation from the
+/// paraboloid), then the flat facets of ours coloured by their centroid's,
+/// all on one signed colour scale in mm, logarithmic over seven decades
+/// below the largest magnitude (red above the paraboloid, towards the focus;
+/// blue below), with the front net's cables and the ring truss (its top
+/// hinges) drawn.
+pub fn surface_plot(figure: &SurfaceFigure, png: &Path) -> Result<(), ReportError> {
+    register_font();
+    let width = 560 * (figure.panels.len() as u32 + 1) + 170;
+    write_atomic_with(png, |temporary| {
+        draw_surface(
+            BitMapBackend::new(temporary, (width, 640)).into_drawing_area(),
+            figure,
+        )
+    })
 }
 
 /// Floor of a logarithmic ratio-error axis (the reference itself has 0).

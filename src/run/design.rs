@@ -10,9 +10,10 @@ use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::report::{
     assembly_vtu, cables_csv, convergence_csv, convergence_plot, surface_plot, write_atomic,
-    write_json,
+    write_json, NodePanel, SurfaceFigure,
 };
 use crate::scene::Scene;
+use crate::verify::Verification;
 use crate::Error;
 
 /// What `ringmesh design` made.
@@ -58,6 +59,64 @@ pub fn design(
     })
 }
 
+/// The surface figure of a design run: the conventional design (when there
+/// is one) and ours as built, and ours's flat facets.
+fn surface_figure(
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    network: &Network,
+    report: &DesignReport,
+) -> SurfaceFigure {
+    let fixed = network.fixed_mask();
+    let front = 0..mesh.n_front_nodes;
+    let deviation_mm = |p: [f64; 3]| 1e3 * mesh.paraboloid.axial_deviation(p);
+    let panel = |title: &str, v: &Verification| NodePanel {
+        title: title.to_string(),
+        nodes: front
+            .clone()
+            .filter(|&i| !fixed[i])
+            .map(|i| {
+                let p = v.nodes_xyz_m[i];
+                (p[0], p[1], deviation_mm(p))
+            })
+            .collect(),
+    };
+    let ours = &report.verification;
+    let mut panels: Vec<NodePanel> = report
+        .conventional
+        .iter()
+        .map(|c| panel("conventional (rigid-truss) design as built", c))
+        .collect();
+    panels.push(panel("this design as built", ours));
+    let plan = |i: usize| (ours.nodes_xyz_m[i][0], ours.nodes_xyz_m[i][1]);
+    let facets = mesh
+        .front_triangles
+        .iter()
+        .map(|t| {
+            let centroid: [f64; 3] = std::array::from_fn(|c| {
+                t.iter().map(|&i| ours.nodes_xyz_m[i][c]).sum::<f64>() / 3.0
+            });
+            (t.map(plan), deviation_mm(centroid))
+        })
+        .collect();
+    let cables = network
+        .edges
+        .iter()
+        .filter(|e| e.iter().all(|&i| front.contains(&i)))
+        .map(|e| e.map(plan))
+        .collect();
+    SurfaceFigure {
+        title: format!(
+            "{}: surface as built on the flexible truss, axial deviation from the paraboloid (mm)",
+            scene.name
+        ),
+        panels,
+        facets,
+        cables,
+        outline: mesh.truss.top_m.iter().map(|p| (p[0], p[1])).collect(),
+    }
+}
+
 /// The files of `ringmesh design`, each written atomically, `design.json`
 /// last, with the time spent writing the others and the command's wall time
 /// since `clock` in its timings.
@@ -87,23 +146,12 @@ fn write_design(
     convergence_plot(
         &series,
         &format!("{}: outer design loop", scene.name),
+        report.tolerance_m,
         &path("convergence.png"),
         &path("convergence.svg"),
     )?;
-    let fixed = network.fixed_mask();
-    let surface: Vec<(f64, f64, f64)> = (0..mesh.n_front_nodes)
-        .filter(|&i| !fixed[i])
-        .map(|i| {
-            let p = report.verification.nodes_xyz_m[i];
-            (p[0], p[1], 1e3 * mesh.paraboloid.axial_deviation(p))
-        })
-        .collect();
     surface_plot(
-        &surface,
-        &format!(
-            "{}: assembled surface error (mm), RMS {:.2e} mm",
-            scene.name, report.verification.rms_mm
-        ),
+        &surface_figure(scene, mesh, network, report),
         &path("surface-error.png"),
     )?;
     write_atomic(
