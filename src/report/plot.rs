@@ -317,6 +317,9 @@ impl DeviationScale {
     }
 }
 
+/// Cables drawn on a surface panel at most: beyond, only the colours.
+const MAX_DRAWN_CABLES: usize = 3_000;
+
 /// One plan-view panel: the truss outline, the cables, and either nodes or
 /// facets coloured by deviation.
 fn draw_surface_panel<DB: DrawingBackend>(
@@ -366,24 +369,31 @@ where
                 .map(|(corners, d)| Polygon::new(corners.to_vec(), scale.colour(*d).filled())),
         )?;
     }
-    let cable = RGBColor(120, 120, 120).stroke_width(1);
-    chart.draw_series(
-        figure
-            .cables
-            .iter()
-            .map(|c| PathElement::new(c.to_vec(), cable)),
-    )?;
+    // A dense net is drawn by its colours alone: its cables and node
+    // outlines would cover them.
+    if figure.cables.len() <= MAX_DRAWN_CABLES {
+        let cable = RGBColor(120, 120, 120).stroke_width(1);
+        chart.draw_series(
+            figure
+                .cables
+                .iter()
+                .map(|c| PathElement::new(c.to_vec(), cable)),
+        )?;
+    }
     if let Some(nodes) = nodes {
+        let radius = (600.0 / (nodes.len().max(1) as f64).sqrt()).clamp(1.5, 5.0) as i32;
         chart.draw_series(
             nodes
                 .iter()
-                .map(|&(x, y, d)| Circle::new((x, y), 5, scale.colour(d).filled())),
+                .map(|&(x, y, d)| Circle::new((x, y), radius, scale.colour(d).filled())),
         )?;
-        chart.draw_series(
-            nodes
-                .iter()
-                .map(|&(x, y, _)| Circle::new((x, y), 5, BLACK.stroke_width(1))),
-        )?;
+        if figure.cables.len() <= MAX_DRAWN_CABLES {
+            chart.draw_series(
+                nodes
+                    .iter()
+                    .map(|&(x, y, _)| Circle::new((x, y), radius, BLACK.stroke_width(1))),
+            )?;
+        }
     }
     let mut ring = figure.outline.clone();
     ring.extend(figure.outline.first());
