@@ -27,6 +27,7 @@ const RMS_FLOOR_MM: f64 = 1e-9;
 fn draw_front<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     points: &[FrontRow],
+    failed: Option<&[(String, f64)]>,
     title: &str,
 ) -> Result<(), DrawError>
 where
@@ -34,6 +35,9 @@ where
 {
     let ok: Vec<&FrontRow> = points.iter().filter(|p| p.ratio.is_finite()).collect();
     root.fill(&WHITE)?;
+    let body = root.titled(title, ("sans-serif", 22))?;
+    let height = body.dim_in_pixel().1 as i32;
+    let (plot, legend) = body.split_vertically(height - 60);
     let x = |p: &FrontRow| p.rms_mm.max(RMS_FLOOR_MM);
     let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
     for p in &ok {
@@ -45,10 +49,9 @@ where
     if ok.is_empty() {
         (x_lo, x_hi, y_lo, y_hi) = (RMS_FLOOR_MM, 1.0, 1.0, 2.0);
     }
-    let (x_lo, x_hi) = (x_lo / 2.0, (x_hi * 2.0).max(x_lo * 10.0));
+    let (x_lo, x_hi) = (x_lo / 2.0, (x_hi * 4.0).max(x_lo * 10.0));
     let (y_lo, y_hi) = ((y_lo * 0.95).max(1.0 - 1e-9), y_hi * 1.05 + 1e-9);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
+    let mut chart = ChartBuilder::on(&plot)
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(60)
@@ -61,38 +64,85 @@ where
         .label_style(("sans-serif", 14))
         .draw()?;
     let mut solvers: Vec<&str> = Vec::new();
-    for p in &ok {
-        if !solvers.contains(&p.solver.as_str()) {
-            solvers.push(&p.solver);
+    let failures = failed.unwrap_or_default();
+    for p in ok
+        .iter()
+        .map(|p| p.solver.as_str())
+        .chain(failures.iter().map(|f| f.0.as_str()))
+    {
+        if !solvers.contains(&p) {
+            solvers.push(p);
         }
     }
-    for (index, solver) in solvers.into_iter().enumerate() {
-        let colour = Palette99::pick(index).to_rgba();
-        let mut series: Vec<(f64, f64)> = ok
-            .iter()
-            .filter(|p| p.solver == solver)
-            .map(|p| (x(p), p.ratio))
-            .collect();
-        series.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let name = solver.to_string();
-        chart
-            .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))?
-            .label(name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
-        chart.draw_series(
-            series
-                .into_iter()
-                .map(|p| Circle::new(p, 4, colour.filled())),
-        )?;
+    let colour = |solver: &str| {
+        Palette99::pick(solvers.iter().position(|s| *s == solver).unwrap_or(0)).to_rgba()
+    };
+    let mut anchors = Vec::new();
+    for solver in &solvers {
+        let c = colour(solver);
+        let mut series: Vec<&FrontRow> =
+            ok.iter().copied().filter(|p| p.solver == *solver).collect();
+        series.sort_by(|a, b| x(a).total_cmp(&x(b)));
+        chart.draw_series(LineSeries::new(
+            series.iter().map(|p| (x(p), p.ratio)),
+            c.stroke_width(2),
+        ))?;
+        // A point below the axis floor is drawn at it, hollow.
+        chart.draw_series(series.iter().map(|p| {
+            let style = if p.rms_mm < RMS_FLOOR_MM {
+                c.stroke_width(2)
+            } else {
+                c.filled()
+            };
+            Circle::new((x(p), p.ratio), 4, style)
+        }))?;
+        anchors.extend(series.iter().map(|p| ((x(p), p.ratio), knob_label(p.knob))));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()?;
+    // Each point labelled with its knob, where the label has room.
+    let pixels: Vec<((i32, i32), Option<&str>)> = anchors
+        .iter()
+        .map(|(p, label)| (chart.backend_coord(p), Some(label.as_str())))
+        .collect();
+    let offsets = place_labels(&pixels);
+    chart.draw_series(
+        anchors
+            .iter()
+            .zip(offsets)
+            .filter_map(|((p, label), offset)| {
+                let offset = offset?;
+                Some(EmptyElement::at(*p) + Text::new(label.clone(), offset, label_font()))
+            }),
+    )?;
+    // The legend below the plot: the solvers, the floor, the failures.
+    let font = ("sans-serif", 14).into_font();
+    let mut at = 70;
+    for solver in &solvers {
+        let c = colour(solver);
+        legend.draw(&PathElement::new(
+            vec![(at, 14), (at + 22, 14)],
+            c.stroke_width(2),
+        ))?;
+        legend.draw(&Text::new(solver.to_string(), (at + 28, 6), font.clone()))?;
+        at += 50 + 8 * solver.len() as i32;
+    }
+    legend.draw(&Circle::new((at, 14), 4, BLACK.stroke_width(2)))?;
+    legend.draw(&Text::new(
+        format!("RMS below {RMS_FLOOR_MM:.0e} mm, drawn at it; labels: the knob"),
+        (at + 10, 6),
+        font.clone(),
+    ))?;
+    let failures = match failed {
+        None => "failed points: not recorded in shards (see each shard's run)".to_string(),
+        Some([]) => "no failed point".to_string(),
+        Some(failed) => {
+            let list: Vec<String> = failed
+                .iter()
+                .map(|(solver, knob)| format!("{solver} at {knob:.0e}"))
+                .collect();
+            format!("failed, no design (not drawn): {}", list.join(", "))
+        }
+    };
+    legend.draw(&Text::new(failures, (70, 32), font))?;
     Ok(root.present()?)
 }
 
@@ -117,14 +167,64 @@ macro_rules! png_and_svg {
 }
 
 /// Draws the design front (ratio against actual surface RMS, one curve per
-/// solver) as PNG and SVG, each written atomically.
+/// solver, each point labelled with its knob where there is room; a point
+/// below the RMS floor drawn hollow at it) as PNG and SVG, each written
+/// atomically; the legend, below the plot, lists the `failed` points
+/// (solver, knob), or says they are unknown (`None`: a merged front).
 pub fn front_plot(
     points: &[FrontRow],
+    failed: Option<&[(String, f64)]>,
     title: &str,
     png: &Path,
     svg: &Path,
 ) -> Result<(), ReportError> {
-    png_and_svg!(draw_front, (900, 600), png, svg, points, title)
+    png_and_svg!(draw_front, (1000, 680), png, svg, points, failed, title)
+}
+
+/// A knob value as a point's label: one significant digit.
+fn knob_label(knob: f64) -> String {
+    if knob == 0.0 {
+        "0".into()
+    } else {
+        format!("{knob:.0e}")
+    }
+}
+
+/// The font of point labels.
+fn label_font() -> TextStyle<'static> {
+    ("sans-serif", LABEL_PX).into_font().into()
+}
+
+/// Height of a point label, px.
+const LABEL_PX: i32 = 12;
+
+/// Where to write each label beside its point (`anchors`: the point in
+/// pixels and its label, if it has one), as a pixel offset from the point:
+/// to the right or left, above or below, else stacked further down, at the
+/// first place that overlaps no label already placed; `None` for a label
+/// with no free place (left out rather than overprinted).
+fn place_labels(anchors: &[((i32, i32), Option<&str>)]) -> Vec<Option<(i32, i32)>> {
+    let mut placed: Vec<[i32; 4]> = Vec::new();
+    anchors
+        .iter()
+        .map(|&((x, y), label)| {
+            let label = label?;
+            let width = 7 * label.chars().count() as i32;
+            let h = LABEL_PX + 1;
+            let candidates = [(7, -h), (7, 2), (-width - 7, -h), (-width - 7, 2)]
+                .into_iter()
+                .chain((1..=4).map(|k| (7, 2 + k * h)));
+            let free = |(dx, dy): (i32, i32)| {
+                let r = [x + dx, y + dy, x + dx + width, y + dy + h];
+                !placed
+                    .iter()
+                    .any(|q| r[0] < q[2] && q[0] < r[2] && r[1] < q[3] && q[1] < r[3])
+            };
+            let (dx, dy) = candidates.into_iter().find(|&c| free(c))?;
+            placed.push([x + dx, y + dy, x + dx + width, y + dy + h]);
+            Some((dx, dy))
+        })
+        .collect()
 }
 
 /// Floor of a logarithmic residual axis, m.
@@ -627,31 +727,16 @@ where
             .iter()
             .map(|&p| Circle::new(p, 9, BLACK.stroke_width(2))),
     )?;
-    // Labels of nearby points are stacked downwards rather than overprinted.
-    let mut placed: Vec<(i32, i32)> = Vec::new();
-    let mut offsets = Vec::with_capacity(ok.len());
-    for (r, label) in &ok {
-        let (px, mut py) = chart.backend_coord(&(r.time_s, y(r)));
-        py -= 14;
-        if label.is_some() {
-            while placed
-                .iter()
-                .any(|&(qx, qy)| (qx - px).abs() < 45 && (qy - py).abs() < 12)
-            {
-                py += 13;
-            }
-            placed.push((px, py));
-        }
-        offsets.push(py - chart.backend_coord(&(r.time_s, y(r))).1);
-    }
-    chart.draw_series(ok.iter().zip(offsets).map(|((r, label), dy)| {
+    let anchors: Vec<((i32, i32), Option<&str>)> = ok
+        .iter()
+        .map(|(r, label)| (chart.backend_coord(&(r.time_s, y(r))), label.as_deref()))
+        .collect();
+    let offsets = place_labels(&anchors);
+    chart.draw_series(ok.iter().zip(offsets).map(|((r, label), offset)| {
+        let text = offset.and(label.as_deref()).unwrap_or_default().to_string();
         EmptyElement::at((r.time_s, y(r)))
             + Circle::new((0, 0), 5, knob_colour(r.knob).filled())
-            + Text::new(
-                label.as_deref().unwrap_or_default().to_string(),
-                (7, dy),
-                ("sans-serif", 12).into_font(),
-            )
+            + Text::new(text, offset.unwrap_or((0, 0)), label_font())
     }))?;
     Ok(())
 }

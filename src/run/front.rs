@@ -58,15 +58,22 @@ pub fn front(
         return Ok((front, vec![path]));
     }
     let rows: Vec<FrontRow> = front.iter().filter_map(FrontRow::of).collect();
-    let paths = write_front(&dir, &scene.name, &rows, &front_csv(&rows))?;
+    let failed: Vec<(String, f64)> = front
+        .iter()
+        .filter(|p| p.outcome.is_err())
+        .map(|p| (study::value_name(&p.solver), p.knob))
+        .collect();
+    let paths = write_front(&dir, &scene.name, &rows, Some(&failed), &front_csv(&rows))?;
     Ok((front, paths))
 }
 
-/// `front.csv` (the table `csv`), `front.png`, `front.svg` (drawn from `rows`).
+/// `front.csv` (the table `csv`), `front.png`, `front.svg` (drawn from `rows`,
+/// the `failed` points — solver, knob — listed when known).
 pub(crate) fn write_front(
     dir: &Path,
     scene: &str,
     rows: &[FrontRow],
+    failed: Option<&[(String, f64)]>,
     csv: &str,
 ) -> Result<Vec<PathBuf>, Error> {
     let paths = [
@@ -75,7 +82,7 @@ pub(crate) fn write_front(
         dir.join("front.svg"),
     ];
     let title = format!("{scene}: tension uniformity against surface accuracy");
-    front_plot(rows, &title, &paths[1], &paths[2])?;
+    front_plot(rows, failed, &title, &paths[1], &paths[2])?;
     write_atomic(&paths[0], csv.as_bytes())?;
     Ok(paths.to_vec())
 }

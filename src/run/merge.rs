@@ -72,7 +72,7 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOu
         );
         // The plots are drawn from the parsed rows; the table is the shards' text.
         let written = match table {
-            Table::Front(rows) => write_front(&dir, &m.header.scene, &rows, &m.csv())?,
+            Table::Front(rows) => write_front(&dir, &m.header.scene, &rows, None, &m.csv())?,
             Table::Study(rows) => write_study(&dir, &m.header.scene, &rows, &m.csv())?,
         };
         outcomes.push(MergeOutcome {
