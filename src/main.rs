@@ -352,10 +352,20 @@ impl Progress for Bar {
     fn step(&self, message: &str) {
         self.0.set_message(message.to_string());
         self.0.inc(1);
+        // Not on a terminal (a batch job's log): one line per step instead.
+        if self.0.is_hidden() {
+            eprintln!(
+                "{}/{} {:.1} s {message}",
+                self.0.position(),
+                self.0.length().unwrap_or(0),
+                self.0.elapsed().as_secs_f64()
+            );
+        }
     }
 }
 
-/// A progress bar on stderr, hidden when stderr is not a terminal.
+/// A progress bar on stderr; when stderr is not a terminal, one line per
+/// finished step instead.
 fn bar() -> Bar {
     let bar = ProgressBar::new(0);
     bar.set_style(

@@ -31,7 +31,15 @@ pub fn front(
     let mine: Vec<(SolverKind, f64)> = indices.iter().map(|&k| jobs[k]).collect();
     progress.start(mine.len());
     let front = design_front_points(&problem, &mine, &|p: &FrontPoint| {
-        progress.step(&format!("{:?} knob {:.3e}", p.solver, p.knob));
+        let outcome = match &p.outcome {
+            Ok(_) => format!("ratio {:.6}, RMS {:.3e} mm", p.ratio, p.rms_mm),
+            Err(e) => format!("failed: {e}"),
+        };
+        progress.step(&format!(
+            "{} knob {:.3e}: {outcome}",
+            study::value_name(&p.solver),
+            p.knob
+        ));
     });
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     if let Some(shard) = shard {

@@ -109,7 +109,12 @@ pub fn study(
     let runs = part.points(total).len() + usize::from(!part.includes(0));
     progress.start(runs);
     let rows = study::run_study(&scene, &settings, part, options.jobs, &|r: &StudyRow| {
-        progress.step(&format!("{} {}", r.knob.name(), r.value));
+        let outcome = match &r.error {
+            Some(e) => format!("failed: {e}"),
+            None => format!("RMS as built {:.3e} mm, design {:.2} s", r.rms_mm, r.time_s),
+        };
+        let point = format!("{} {}", r.knob.name(), r.value);
+        progress.step(&format!("{}: {outcome}", point.trim_end()));
     })?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     let written = match shard {
