@@ -419,9 +419,9 @@ fn main() -> ExitCode {
             .map(|outcome| {
                 let r = &outcome.report;
                 say!(
-                    "{}: {:?} after {} outer iterations, boundary residual {:.3e} m, ratio {:.6}",
+                    "{}: {} after {} outer iterations, boundary residual {:.3e} m, ratio {:.6}",
                     r.relaxation.name(),
-                    r.termination,
+                    json_name(&r.termination),
                     r.outer_iterations,
                     r.boundary_residual_m,
                     r.ratio
@@ -548,8 +548,8 @@ fn main() -> ExitCode {
                 1e3 * d.surface_max_m
             );
             say!(
-                "termination: {:?} after {} iterations, {:.3} s",
-                d.termination,
+                "termination: {} after {} iterations, {:.3} s",
+                json_name(&d.termination),
                 d.iterations,
                 d.time_s
             );
@@ -582,8 +582,8 @@ fn main() -> ExitCode {
             say!("ratio: {:.6}", o.ratio);
             say!("max residual: {:.3e} N", o.max_residual);
             say!(
-                "termination: {:?} after {} iterations, {:.3} s",
-                o.termination,
+                "termination: {} after {} iterations, {:.3} s",
+                json_name(&o.termination),
                 o.iterations,
                 o.time_s
             );
@@ -616,14 +616,19 @@ fn main() -> ExitCode {
                 for p in &points {
                     match &p.outcome {
                         Ok(t) => say!(
-                            "{:?} knob {:.3e}: ratio {:.6}, RMS {:.3e} mm, {:.3} s ({t:?})",
-                            p.solver,
+                            "{} knob {:.3e}: ratio {:.6}, RMS {:.3e} mm, {:.3} s ({})",
+                            ringmesh::study::value_name(&p.solver),
                             p.knob,
                             p.ratio,
                             p.rms_mm,
-                            p.time_s
+                            p.time_s,
+                            json_name(t)
                         ),
-                        Err(e) => say!("{:?} knob {:.3e}: failed: {e}", p.solver, p.knob),
+                        Err(e) => say!(
+                            "{} knob {:.3e}: failed: {e}",
+                            ringmesh::study::value_name(&p.solver),
+                            p.knob
+                        ),
                     }
                 }
                 for path in written {
@@ -751,6 +756,15 @@ fn main() -> ExitCode {
             eprintln!("error: {error}");
             ExitCode::from(if error.is_bad_input() { 2 } else { 1 })
         }
+    }
+}
+
+/// A value's name as the JSON files spell it (`converged`,
+/// `max_iterations`), not Rust's.
+fn json_name<T: serde::Serialize + std::fmt::Debug>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(name)) => name,
+        _ => format!("{value:?}"),
     }
 }
 

@@ -295,9 +295,13 @@ fn optimize_writes_design_and_cut_lengths() {
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    // The printout names the status as design.json does, not as Rust does.
+    let printed = String::from_utf8_lossy(&run.stdout);
+    assert!(printed.contains("termination: converged"), "{printed}");
     let design: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
     assert_eq!(design["scene"], "small-hex");
+    assert_eq!(design["termination"], "converged");
     assert_eq!(design["termination"], "converged");
     let csv = std::fs::read_to_string(out.join("cables.csv")).unwrap();
     let mut lines = csv.lines();
