@@ -27,12 +27,12 @@ pub fn cables_csv(network: &Network, design: &Design, cables: &Cables) -> String
         let (t, l) = (design.tensions_n[k], design.lengths_m[k]);
         let _ = writeln!(
             s,
-            "{k},{},{i},{j},{:.12e},{:.12e},{:.12e},{:.12e}",
+            "{k},{},{i},{j},{},{},{},{}",
             network.group_of(k),
-            design.q[k],
-            t,
-            l,
-            cables.cut_length_m(l, t)
+            plain(design.q[k]),
+            plain(t),
+            plain(l),
+            plain(cables.cut_length_m(l, t))
         );
     }
     s
@@ -305,6 +305,17 @@ impl RowError {
             expected,
         }
     }
+}
+
+/// `v` in plain decimal notation with 13 significant digits (the `{:.12e}`
+/// it replaces kept as many): a cutting sheet's numbers, read by any
+/// spreadsheet without an exponent.
+fn plain(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (12 - v.abs().log10().floor() as i32).clamp(0, 24) as usize;
+    format!("{v:.decimals$}")
 }
 
 /// `outer_diameter_m,…`: one row per section a sizing tried, in the order
