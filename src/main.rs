@@ -339,6 +339,9 @@ enum Command {
         /// Print the table as JSON instead.
         #[arg(long)]
         json: bool,
+        /// Also write the table to this folder, as cantilever.json.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
 }
 
@@ -739,7 +742,8 @@ fn main() -> ExitCode {
             elements,
             element,
             json,
-        } => ringmesh::run::cantilever(*elements, *element).map(|table| {
+            output,
+        } => ringmesh::run::cantilever(*elements, *element, output.as_deref()).map(|table| {
             if *json {
                 say!(
                     "{}",

@@ -420,3 +420,21 @@ fn the_readme_main_command_leaves_a_clean_checkout() {
         "git status after {args:?}"
     );
 }
+
+#[test]
+fn cantilever_writes_its_table_where_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "cantilever");
+    let run = common::ringmesh(&["cantilever", "--json", "-o", out.to_str().unwrap()]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let printed: Value = serde_json::from_slice(&run.stdout).unwrap();
+    let written: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("cantilever.json")).unwrap())
+            .unwrap();
+    assert_eq!(printed, written);
+    assert_eq!(written["rows"].as_array().unwrap().len(), 7);
+}

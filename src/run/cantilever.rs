@@ -1,11 +1,14 @@
 //! `ringmesh cantilever`: the paper's cantilever under a tip moment (§3.4,
 //! Tables 1–2) beside the closed form and the paper's figures.
 
+use std::path::Path;
+
 use serde::Serialize;
 
 use crate::frame::cantilever::{self, CantileverRow};
 use crate::frame::FrameFileError;
 use crate::mechanics::ElementKind;
+use crate::report::write_json;
 use crate::Error;
 
 /// One row of `ringmesh cantilever`: the engine's row and the paper's result
@@ -35,8 +38,16 @@ pub struct CantileverTable {
 }
 
 /// `ringmesh cantilever`: the paper's Tables 1–2 (§3.4) with `elements`
-/// elements of `kind`, every load from 0.2 to the full circle.
-pub fn cantilever(elements: usize, kind: ElementKind) -> Result<CantileverTable, Error> {
+/// elements of `kind`, every load from 0.2 to the full circle; with
+/// `output_dir`, also written there as `cantilever.json`.
+///
+/// # Errors
+/// The engine's, and the writer's.
+pub fn cantilever(
+    elements: usize,
+    kind: ElementKind,
+    output_dir: Option<&Path>,
+) -> Result<CantileverTable, Error> {
     let rows = cantilever::table(elements, kind)
         .map_err(FrameFileError::from)?
         .into_iter()
@@ -49,9 +60,13 @@ pub fn cantilever(elements: usize, kind: ElementKind) -> Result<CantileverTable,
             }
         })
         .collect();
-    Ok(CantileverTable {
+    let table = CantileverTable {
         elements,
         element: kind.name().to_string(),
         rows,
-    })
+    };
+    if let Some(dir) = output_dir {
+        write_json(&dir.join("cantilever.json"), &table)?;
+    }
+    Ok(table)
 }
