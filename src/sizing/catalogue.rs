@@ -107,7 +107,8 @@ pub fn read(path: &Path, truss: &Truss) -> Result<Vec<TubeSection>, SizingError>
 }
 
 /// Parses catalogue text (`source` names it in errors): a header of the
-/// first two, three or four of [`COLUMNS`], then one section per line;
+/// first two, three or four of `outer_diameter_m,inner_diameter_m,
+/// youngs_modulus_pa,density_kg_per_m3`, then one section per line;
 /// blank lines and lines starting with `#` are skipped.
 ///
 /// # Errors

@@ -57,7 +57,7 @@ pub enum RelaxationKind {
     Paper,
     /// Aitken's dynamic scalar relaxation.
     Aitken,
-    /// Anderson mixing (depth [`super::LoopSettings::anderson_depth`]).
+    /// Anderson mixing of the last 10 iterates (`LoopSettings::anderson_depth`).
     #[default]
     Anderson,
 }
