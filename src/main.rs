@@ -9,6 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ringmesh::algebra::norm3;
 use ringmesh::design::RelaxationKind;
 use ringmesh::mechanics::{ElementKind, StaticTermination};
+use ringmesh::report::json_name;
 use ringmesh::run::{CantileverTable, FrameOutput, Progress};
 use ringmesh::scene::TrussModel;
 use ringmesh::shard::Shard;
@@ -384,9 +385,7 @@ fn main() -> ExitCode {
         Command::Mesh { scene, output } => ringmesh::run::mesh(scene, output.as_deref()).map(|m| {
             say!("scene: {}", m.scene);
             say!("{}", m.summary.to_string().trim_end());
-            for path in m.written {
-                say!("wrote {}", path.display());
-            }
+            say_written(&m.written);
         }),
         Command::Fdm { network, output } => ringmesh::run::fdm(network, output).map(|o| {
             say!("max residual: {:.3e} N", o.max_residual);
@@ -471,9 +470,7 @@ fn main() -> ExitCode {
                 for w in &r.net.warnings {
                     say!("warning: {w}");
                 }
-                for path in &outcome.written {
-                    say!("wrote {}", path.display());
-                }
+                say_written(&outcome.written);
             })
         }
         Command::Apertures {
@@ -494,9 +491,7 @@ fn main() -> ExitCode {
                 for r in &outcome.results {
                     say!("{}", aperture_line(r));
                 }
-                for path in &outcome.written {
-                    say!("wrote {}", path.display());
-                }
+                say_written(&outcome.written);
             })
         }
         Command::Size {
@@ -527,9 +522,7 @@ fn main() -> ExitCode {
                     s.trials.len(),
                     section_line(chosen)
                 );
-                for path in &outcome.written {
-                    say!("wrote {}", path.display());
-                }
+                say_written(&outcome.written);
             })
         }
         Command::Optimize {
@@ -562,9 +555,7 @@ fn main() -> ExitCode {
             for w in &d.warnings {
                 say!("warning: {w}");
             }
-            for path in written {
-                say!("wrote {}", path.display());
-            }
+            say_written(&written);
         }),
         Command::Uniformity {
             network,
@@ -634,9 +625,7 @@ fn main() -> ExitCode {
                         ),
                     }
                 }
-                for path in written {
-                    say!("wrote {}", path.display());
-                }
+                say_written(&written);
             })
         }
         Command::Study {
@@ -693,9 +682,7 @@ fn main() -> ExitCode {
                         ),
                     }
                 }
-                for path in &outcome.written {
-                    say!("wrote {}", path.display());
-                }
+                say_written(&outcome.written);
             })
         }
         Command::Merge { paths, output } => {
@@ -708,9 +695,7 @@ fn main() -> ExitCode {
                         m.shards,
                         m.rows
                     );
-                    for path in &m.written {
-                        say!("wrote {}", path.display());
-                    }
+                    say_written(&m.written);
                 }
             })
         }
@@ -763,12 +748,10 @@ fn main() -> ExitCode {
     }
 }
 
-/// A value's name as the JSON files spell it (`converged`,
-/// `max_iterations`), not Rust's.
-fn json_name<T: serde::Serialize + std::fmt::Debug>(value: &T) -> String {
-    match serde_json::to_value(value) {
-        Ok(serde_json::Value::String(name)) => name,
-        _ => format!("{value:?}"),
+/// One `wrote PATH` line per file written.
+fn say_written(paths: &[PathBuf]) {
+    for path in paths {
+        say!("wrote {}", path.display());
     }
 }
 

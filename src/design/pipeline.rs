@@ -19,7 +19,7 @@ use crate::mechanics::LimitSearch;
 use crate::network::Network;
 use crate::scene::{Scene, TrussModel};
 use crate::truss::{RingTruss, TrussError};
-use crate::uniformity::{Design, SolverKind};
+use crate::uniformity::{Design, SolverKind, UniformitySet};
 use crate::verify::{verify, AssemblyTruss, Verification};
 use crate::Error;
 
@@ -196,6 +196,8 @@ pub struct DesignRun {
     /// The conventional design (the loop's iteration 0), when the truss
     /// deforms: the one `report.conventional` assembles.
     pub conventional_net: Option<Design>,
+    /// The uniformity sets the design makes uniform (cables of `network`).
+    pub sets: Vec<UniformitySet>,
 }
 
 /// The outer design loop (net design ⇄ truss response) of `scene` with each
@@ -306,6 +308,7 @@ pub fn run(
     timings.margin_s = stage.elapsed().as_secs_f64();
     let stage = Instant::now();
     let network = outcome.problem.network().clone();
+    let sets = outcome.problem.sets().to_vec();
     let verification = verify(
         scene,
         mesh,
@@ -361,6 +364,7 @@ pub fn run(
         mesh: scene_nets.mesh,
         network,
         conventional_net,
+        sets,
     })
 }
 

@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use crate::design::{LoopRun, LoopTermination};
+use crate::design::LoopRun;
 use crate::network::Network;
 use crate::scene::{Cables, TrussModel};
 use crate::sizing::SectionTrial;
@@ -125,18 +125,10 @@ pub fn study_row(r: &StudyRow) -> String {
         value_name(&s.solver),
         r.time_s,
         r.outer_iterations.map_or(String::new(), |n| n.to_string()),
-        r.termination.map_or(String::new(), termination_name),
+        r.termination.map_or(String::new(), |t| json_name(&t)),
         g(r.boundary_residual_m),
-        if r.ratio.is_finite() {
-            format!("{:.10e}", r.ratio)
-        } else {
-            String::new()
-        },
-        if r.built_ratio.is_finite() {
-            format!("{:.10e}", r.built_ratio)
-        } else {
-            String::new()
-        },
+        finite(r.ratio),
+        finite(r.built_ratio),
         g(r.ratio_error),
         g(r.rms_mm),
         g(r.max_deviation_mm),
@@ -147,11 +139,14 @@ pub fn study_row(r: &StudyRow) -> String {
     )
 }
 
-fn termination_name(t: LoopTermination) -> String {
-    serde_json::to_value(t)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_string))
-        .unwrap_or_default()
+/// A unit variant's name as the JSON files spell it (`converged`,
+/// `max_iterations`), not Rust's `Debug` (which it falls back to for a
+/// value that is not a plain name).
+pub fn json_name<T: serde::Serialize + std::fmt::Debug>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(name)) => name,
+        _ => format!("{value:?}"),
+    }
 }
 
 /// The accuracy study, one row per point, in sweep order.
@@ -338,7 +333,7 @@ pub fn sizing_csv(trials: &[SectionTrial]) -> String {
             t.margin,
             t.bound.map_or("", |b| b.kind()),
             t.outer_iterations,
-            t.termination.map_or(String::new(), termination_name),
+            t.termination.map_or(String::new(), |t| json_name(&t)),
             t.rms_mm.map_or(String::new(), |v| format!("{v:.6e}")),
             t.carries,
             t.time_s,
@@ -431,6 +426,7 @@ pub fn convergence_csv(runs: &[LoopRun]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::LoopTermination;
 
     #[test]
     fn study_rows_read_back_as_written() {

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 pub use csv::{
-    aperture_csv, cables_csv, convergence_csv, front_csv, front_row, parse_front_row,
+    aperture_csv, cables_csv, convergence_csv, front_csv, front_row, json_name, parse_front_row,
     parse_study_row, sizing_csv, study_csv, study_row, FrontRow, FRONT_COLUMNS, STUDY_COLUMNS,
 };
 pub use plot::{

@@ -34,10 +34,7 @@ where
     DB::ErrorType: 'static,
 {
     let ok: Vec<&FrontRow> = points.iter().filter(|p| p.ratio.is_finite()).collect();
-    root.fill(&WHITE)?;
-    let body = root.titled(title, ("sans-serif", 22))?;
-    let height = body.dim_in_pixel().1 as i32;
-    let (plot, legend) = body.split_vertically(height - 60);
+    let (plot, legend) = titled_with_legend(&root, title, 60)?;
     let x = |p: &FrontRow| p.rms_mm.max(RMS_FLOOR_MM);
     let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
     for p in &ok {
@@ -227,6 +224,25 @@ fn place_labels(anchors: &[((i32, i32), Option<&str>)]) -> Vec<Option<(i32, i32)
         .collect()
 }
 
+/// A drawing area in pixels.
+type Area<DB> = DrawingArea<DB, plotters::coord::Shift>;
+
+/// `root` titled, split into the plots above and a legend strip of
+/// `legend_px` below them (legends there cover no data).
+fn titled_with_legend<DB: DrawingBackend>(
+    root: &Area<DB>,
+    title: &str,
+    legend_px: i32,
+) -> Result<(Area<DB>, Area<DB>), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let body = root.titled(title, ("sans-serif", 22))?;
+    let height = body.dim_in_pixel().1 as i32;
+    Ok(body.split_vertically(height - legend_px))
+}
+
 /// Floor of a logarithmic residual axis, m.
 const RESIDUAL_FLOOR_M: f64 = 1e-12;
 
@@ -399,10 +415,19 @@ impl DeviationScale {
         }
     }
 
+    /// `ln(1 + m/linear)`: the bar's length of a magnitude `m`.
+    fn stretch(&self, m: f64) -> f64 {
+        (1.0 + m / self.linear).ln()
+    }
+
     /// Position of `d` on the bar, in `[-1, 1]`.
     fn position(&self, d: f64) -> f64 {
-        let f = |m: f64| (1.0 + m / self.linear).ln();
-        (d.signum() * f(d.abs()) / f(self.largest)).clamp(-1.0, 1.0)
+        (d.signum() * self.stretch(d.abs()) / self.stretch(self.largest)).clamp(-1.0, 1.0)
+    }
+
+    /// The deviation at position `t` of the bar (the inverse of `position`).
+    fn deviation_at(&self, t: f64) -> f64 {
+        t.signum() * self.linear * ((t.abs() * self.stretch(self.largest)).exp() - 1.0)
     }
 
     /// Red above the paraboloid (towards the focus), blue below, white on it.
@@ -527,10 +552,7 @@ where
     chart.draw_series((0..steps).map(|k| {
         let a = -1.0 + 2.0 * k as f64 / steps as f64;
         let b = a + 2.0 / steps as f64;
-        // The colour at the bar's position t is that of the deviation there.
-        let t = 0.5 * (a + b);
-        let f = |m: f64| (1.0 + m / scale.linear).ln();
-        let d = t.signum() * scale.linear * ((t.abs() * f(scale.largest)).exp() - 1.0);
+        let d = scale.deviation_at(0.5 * (a + b));
         Rectangle::new([(0.0, a), (0.25, b)], scale.colour(d).filled())
     }))?;
     let font = ("sans-serif", 13).into_font();
@@ -777,10 +799,7 @@ fn draw_study<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE)?;
-    let body = root.titled(title, ("sans-serif", 22))?;
-    let height = body.dim_in_pixel().1 as i32;
-    let (charts, legend) = body.split_vertically(height - 35);
+    let (charts, legend) = titled_with_legend(&root, title, 35)?;
     let panels = charts.split_evenly((1, 2));
     let rms = StudyPanel {
         y_desc: "surface RMS as built on the reference truss (mm)",
@@ -893,10 +912,7 @@ fn draw_apertures<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE)?;
-    let body = root.titled(title, ("sans-serif", 22))?;
-    let height = body.dim_in_pixel().1 as i32;
-    let (charts, legend) = body.split_vertically(height - 35);
+    let (charts, legend) = titled_with_legend(&root, title, 35)?;
     let panels = charts.split_evenly((1, 2));
     // The legend below the panels: the lines cross every part of them.
     let font = ("sans-serif", 15).into_font();

@@ -29,8 +29,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::design::{scene_problem, DesignRun, DesignSettings};
-use crate::geometry::RingTrussLayout;
+use crate::design::{DesignRun, DesignSettings};
 use crate::scene::{membrane_tension_n, Scene, TrussModel};
 use crate::sizing::{size_truss, Sections, SizingError, TubeSection};
 use crate::uniformity::Design;
@@ -217,7 +216,7 @@ pub fn run_aperture_study(
             chosen.mass_kg,
             sizing.trials.len(),
             sizing_time_s,
-        )?;
+        );
         observe(&result);
         results.push(result);
     }
@@ -233,9 +232,8 @@ fn aperture_result(
     truss_mass_kg: f64,
     sizing_designs: usize,
     sizing_time_s: f64,
-) -> Result<ApertureResult, Error> {
-    let (_, problem) = scene_problem(&scene)?;
-    let sets = problem.sets();
+) -> ApertureResult {
+    let sets = &exact.sets;
     let cut_lengths = |design: &Design| -> Vec<f64> {
         design
             .lengths_m
@@ -300,14 +298,14 @@ fn aperture_result(
             report.timings.design_loop_s(),
         ),
     ];
-    let layout = RingTrussLayout::of(&scene);
+    let layout = &exact.mesh.truss;
     let hinges = layout.top_m.iter().chain(&layout.bottom_m);
     let hinge_motion_mm = 1e3
         * hinges
             .zip(&report.boundary_m)
             .map(|(a, b)| crate::algebra::norm3(std::array::from_fn(|i| a[i] - b[i])))
             .fold(0.0, f64::max);
-    Ok(ApertureResult {
+    ApertureResult {
         aperture_m: scene.reflector.aperture_diameter_m,
         rings: scene.front_net.rings,
         nodes: exact.network.n_nodes(),
@@ -319,5 +317,5 @@ fn aperture_result(
         hinge_motion_mm,
         models,
         scene,
-    })
+    }
 }
