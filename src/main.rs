@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ringmesh::algebra::norm3;
 use ringmesh::design::RelaxationKind;
 use ringmesh::mechanics::{ElementKind, StaticTermination};
-use ringmesh::report::json_name;
+use ringmesh::report::{json_name, readable};
 use ringmesh::run::{CantileverTable, FrameOutput, Progress};
 use ringmesh::scene::TrussModel;
 use ringmesh::shard::Shard;
@@ -75,9 +75,10 @@ enum Command {
     Design {
         /// The scene file (TOML).
         scene: PathBuf,
-        /// The uniformity solver.
-        #[arg(long, value_enum, default_value = "lp")]
-        solver: SolverKind,
+        /// The uniformity solver [default: lp for one uniformity set without
+        /// loads, bisection otherwise].
+        #[arg(long, value_enum)]
+        solver: Option<SolverKind>,
         /// The truss model [default: the scene's [effects] truss].
         #[arg(long, value_enum)]
         truss: Option<TrussModel>,
@@ -118,9 +119,10 @@ enum Command {
         /// A catalogue of tube sections (CSV) [default: any outer diameter].
         #[arg(long)]
         sections: Option<PathBuf>,
-        /// The uniformity solver.
-        #[arg(long, value_enum, default_value = "lp")]
-        solver: SolverKind,
+        /// The uniformity solver [default: lp for one uniformity set without
+        /// loads, bisection otherwise].
+        #[arg(long, value_enum)]
+        solver: Option<SolverKind>,
         /// Output folder [default: results/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -160,9 +162,10 @@ enum Command {
     Optimize {
         /// The scene file (TOML).
         scene: PathBuf,
-        /// The uniformity solver.
-        #[arg(long, value_enum, default_value = "bisection")]
-        solver: SolverKind,
+        /// The uniformity solver [default: lp for one uniformity set without
+        /// loads, bisection otherwise].
+        #[arg(long, value_enum)]
+        solver: Option<SolverKind>,
         /// Output folder [default: results/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -177,9 +180,10 @@ enum Command {
     Uniformity {
         /// The network file (interchange JSON).
         network: PathBuf,
-        /// The uniformity solver.
-        #[arg(long, value_enum, default_value = "bisection")]
-        solver: SolverKind,
+        /// The uniformity solver [default: lp for one uniformity set without
+        /// loads, bisection otherwise].
+        #[arg(long, value_enum)]
+        solver: Option<SolverKind>,
         /// Groups whose union is made uniform [default: front, or all cables when
         /// the file has no groups].
         #[arg(long, value_delimiter = ',')]
@@ -421,30 +425,31 @@ fn main() -> ExitCode {
             .map(|outcome| {
                 let r = &outcome.report;
                 say!(
-                    "{}: {} after {} outer iterations, boundary residual {:.3e} m, ratio {:.6}",
+                    "{}: {} after {} outer iterations of {}, boundary residual {:.3e} m, ratio {:.6}",
                     r.relaxation.name(),
                     json_name(&r.termination),
                     r.outer_iterations,
+                    r.solver,
                     r.boundary_residual_m,
                     r.ratio
                 );
                 let v = &r.verification;
                 say!(
-                    "assembled{}: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, boundary {:.3e} mm, {} slack cables",
+                    "assembled{}: RMS {} mm (max {} mm), tension change {} %, boundary {} mm, {} slack cables",
                     cables_note(v),
-                    v.rms_mm,
-                    v.max_deviation_mm,
-                    v.max_tension_change_pct,
-                    v.boundary_deviation_mm,
+                    readable(v.rms_mm, 4),
+                    readable(v.max_deviation_mm, 4),
+                    readable(v.max_tension_change_pct, 4),
+                    readable(v.boundary_deviation_mm, 4),
                     v.slack_cables.len()
                 );
                 if let Some(c) = &r.conventional {
                     say!(
-                        "conventional (rigid-truss) design assembled{}: RMS {:.3e} mm (max {:.3e} mm), tension change {:.3e} %, {} slack cables",
+                        "conventional (rigid-truss) design assembled{}: RMS {} mm (max {} mm), tension change {} %, {} slack cables",
                         cables_note(c),
-                        c.rms_mm,
-                        c.max_deviation_mm,
-                        c.max_tension_change_pct,
+                        readable(c.rms_mm, 4),
+                        readable(c.max_deviation_mm, 4),
+                        readable(c.max_tension_change_pct, 4),
                         c.slack_cables.len()
                     );
                 }
@@ -539,14 +544,15 @@ fn main() -> ExitCode {
                 );
             }
             say!(
-                "surface RMS: {:.3e} mm (max {:.3e} mm)",
-                1e3 * d.surface_rms_m,
-                1e3 * d.surface_max_m
+                "surface RMS: {} mm (max {} mm)",
+                readable(1e3 * d.surface_rms_m, 4),
+                readable(1e3 * d.surface_max_m, 4)
             );
             say!(
-                "termination: {} after {} iterations, {:.3} s",
+                "termination: {} after {} iterations of {}, {:.3} s",
                 json_name(&d.termination),
                 d.iterations,
+                d.solver,
                 d.time_s
             );
             if let Some(route) = d.route {
@@ -576,9 +582,10 @@ fn main() -> ExitCode {
             say!("ratio: {:.6}", o.ratio);
             say!("max residual: {:.3e} N", o.max_residual);
             say!(
-                "termination: {} after {} iterations, {:.3} s",
+                "termination: {} after {} iterations of {}, {:.3} s",
                 json_name(&o.termination),
                 o.iterations,
+                o.solver,
                 o.time_s
             );
             if let Some(route) = o.route {
@@ -762,10 +769,10 @@ fn aperture_line(r: &ringmesh::study::ApertureResult) -> String {
         .iter()
         .map(|m| {
             format!(
-                "{} {:.2e} mm / {:.2e} %",
+                "{} {} mm / {} %",
                 ringmesh::study::value_name(&m.model),
-                m.rms_mm,
-                m.tension_change_pct
+                readable(m.rms_mm, 3),
+                readable(m.tension_change_pct, 3)
             )
         })
         .collect();
@@ -790,8 +797,9 @@ fn section_line(t: &ringmesh::sizing::SectionTrial) -> String {
     let outcome = match (&t.failure, t.rms_mm) {
         (Some(f), _) => format!("no design: {f}"),
         (None, Some(rms)) => format!(
-            "{} outer iterations, RMS as built {rms:.2e} mm",
-            t.outer_iterations
+            "{} outer iterations, RMS as built {} mm",
+            t.outer_iterations,
+            readable(rms, 3)
         ),
         (None, None) => String::new(),
     };

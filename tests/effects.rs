@@ -35,38 +35,43 @@ fn small_hex(dir: &Path, gravity: Option<[f64; 3]>) -> PathBuf {
 #[test]
 fn a_scene_builds_only_the_physics_it_asks_for() {
     let dir = tempfile::tempdir().unwrap();
-    // What one `design` run of `scene` with `truss` constructed, per effect.
+    // What one `design` run of `scene` with `truss` and the default solver
+    // constructed, per effect; the solver it took.
     let constructed_by = |scene: &Path, truss| {
         effects::reset_log();
         let options = DesignSettings {
-            solver: SolverKind::Bisection,
             truss: Some(truss),
             ..DesignSettings::default()
         };
         let out = tempfile::tempdir_in(dir.path()).unwrap();
-        design(scene, &options, Some(out.path()), &mut |_, _| {}).unwrap();
+        let run = design(scene, &options, Some(out.path()), &mut |_, _| {}).unwrap();
         let log = effects::constructed();
-        move |kind| log.get(&kind).copied().unwrap_or(0)
+        let count = move |kind| log.get(&kind).copied().unwrap_or(0);
+        (count, run.report.solver)
     };
     let plain_dir = tempfile::tempdir_in(dir.path()).unwrap();
     let heavy_dir = tempfile::tempdir_in(dir.path()).unwrap();
     let plain = small_hex(plain_dir.path(), None);
     let heavy = small_hex(heavy_dir.path(), Some([0.0, 0.0, -1.0]));
 
-    // Rigid and weightless: no beam model, no self weight.
-    let count = constructed_by(&plain, TrussModel::Rigid);
+    // Rigid and weightless: no beam model, no self weight; one unloaded set
+    // takes the default `lp`.
+    let (count, solver) = constructed_by(&plain, TrussModel::Rigid);
+    assert_eq!(solver, "lp");
     assert_eq!(count(EffectKind::BeamModel), 0);
     assert_eq!(count(EffectKind::CableSelfWeight), 0);
     assert_eq!(count(EffectKind::TrussSelfWeight), 0);
 
     // Exact and weightless: beam models, still no self weight.
-    let count = constructed_by(&plain, TrussModel::Exact);
+    let (count, _) = constructed_by(&plain, TrussModel::Exact);
     assert!(count(EffectKind::BeamModel) > 0);
     assert_eq!(count(EffectKind::CableSelfWeight), 0);
     assert_eq!(count(EffectKind::TrussSelfWeight), 0);
 
-    // Rigid under gravity: the cables' weight, never a beam model or its weight.
-    let count = constructed_by(&heavy, TrussModel::Rigid);
+    // Rigid under gravity: the cables' weight, never a beam model or its
+    // weight; the loaded nets take `bisection` (`lp` is for unloaded nets).
+    let (count, solver) = constructed_by(&heavy, TrussModel::Rigid);
+    assert_eq!(solver, "bisection");
     assert!(count(EffectKind::CableSelfWeight) > 0);
     assert_eq!(count(EffectKind::BeamModel), 0);
     assert_eq!(count(EffectKind::TrussSelfWeight), 0);

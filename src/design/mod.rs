@@ -40,7 +40,7 @@ pub use pipeline::{design_margin, run, DesignReport, DesignRun, DesignSettings, 
 pub use relaxation::{
     aitken_factor, paper_step, Aitken, Anderson, Paper, Relaxation, RelaxationKind, Step,
 };
-pub use scene_nets::{scene_problem, SceneNets};
+pub use scene_nets::{default_solver, scene_problem, SceneNets};
 pub use tied_nets::{TiedDesign, TiedNets};
 
 use crate::truss::TrussError;

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings, LoopTermination};
 use super::relaxation::RelaxationKind;
-use super::scene_nets::SceneNets;
+use super::scene_nets::{default_solver, SceneNets};
 use super::DesignError;
 use crate::effects::SceneEffects;
 use crate::geometry::ReflectorMesh;
@@ -26,8 +26,9 @@ use crate::Error;
 /// Choices of a design run: plain data with defaults.
 #[derive(Debug, Clone)]
 pub struct DesignSettings {
-    /// The uniformity solver.
-    pub solver: SolverKind,
+    /// The uniformity solver (default: the scene's,
+    /// [`default_solver`]).
+    pub solver: Option<SolverKind>,
     /// The truss model (default: the scene's `[effects] truss`).
     pub truss: Option<TrussModel>,
     /// Relaxation policies: the first makes the design; the others only add
@@ -43,7 +44,7 @@ impl Default for DesignSettings {
     fn default() -> Self {
         let loop_settings = LoopSettings::default();
         DesignSettings {
-            solver: SolverKind::Lp,
+            solver: None,
             truss: None,
             relaxations: vec![loop_settings.relaxation],
             tolerance_m: loop_settings.tolerance_m,
@@ -221,7 +222,10 @@ pub fn run(
     let scene_nets = SceneNets::new(scene)?;
     timings.mesh_s = clock.elapsed().as_secs_f64();
     let (mesh, nets) = (&scene_nets.mesh, &scene_nets.nets);
-    let solver = settings.solver.build(None);
+    let solver = settings
+        .solver
+        .unwrap_or_else(|| default_solver(scene))
+        .build(None);
     let relaxations = if settings.relaxations.is_empty() {
         vec![RelaxationKind::default()]
     } else {

@@ -7,7 +7,7 @@ use super::tied_nets::TiedNets;
 use crate::effects::SceneEffects;
 use crate::geometry::{build_mesh, ReflectorMesh};
 use crate::scene::{Scene, TrussModel};
-use crate::uniformity::{UniformityProblem, UniformitySolver};
+use crate::uniformity::{SolverKind, UniformityProblem, UniformitySolver};
 use crate::Error;
 
 /// The uniformity problem of a scene's front net for its theoretical boundary,
@@ -18,6 +18,15 @@ use crate::Error;
 /// A mesh or uniformity problem that cannot be built.
 pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem), Error> {
     problem_with(scene, &SceneEffects::of(scene))
+}
+
+/// The uniformity solver a scene is designed with when none is named
+/// ([`SolverKind::default_for`]: gravity loads the nets).
+pub fn default_solver(scene: &Scene) -> SolverKind {
+    SolverKind::default_for(
+        scene.uniformity.groups.len(),
+        scene.effects.gravity.is_some(),
+    )
 }
 
 /// [`scene_problem`] with the effects already built.

@@ -29,10 +29,10 @@ pub fn cables_csv(network: &Network, design: &Design, cables: &Cables) -> String
             s,
             "{k},{},{i},{j},{},{},{},{}",
             network.group_of(k),
-            plain(design.q[k]),
-            plain(t),
-            plain(l),
-            plain(cables.cut_length_m(l, t))
+            super::decimal(design.q[k], 13),
+            super::decimal(t, 13),
+            super::decimal(l, 13),
+            super::decimal(cables.cut_length_m(l, t), 13)
         );
     }
     s
@@ -300,17 +300,6 @@ impl RowError {
             expected,
         }
     }
-}
-
-/// `v` in plain decimal notation with 13 significant digits (the `{:.12e}`
-/// it replaces kept as many): a cutting sheet's numbers, read by any
-/// spreadsheet without an exponent.
-fn plain(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let decimals = (12 - v.abs().log10().floor() as i32).clamp(0, 24) as usize;
-    format!("{v:.decimals$}")
 }
 
 /// `outer_diameter_m,…`: one row per section a sizing tried, in the order

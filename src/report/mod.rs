@@ -85,6 +85,26 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
     result.map_err(io)
 }
 
+/// `v` in plain decimal with `digits` significant digits (`41.65`,
+/// `0.002731`), for a reader: no exponent where a person reads one badly.
+pub fn decimal(v: f64, digits: usize) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (digits as i32 - 1 - v.abs().log10().floor() as i32).clamp(0, 30) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// `v` for a person: [`decimal`] from 1e-3 to 1e6 in magnitude, scientific
+/// (`2.134e-7`) beyond, `digits` significant digits either way.
+pub fn readable(v: f64, digits: usize) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-3..1e6).contains(&v.abs()) {
+        decimal(v, digits)
+    } else {
+        format!("{v:.*e}", digits.saturating_sub(1))
+    }
+}
+
 /// What a drawing fails with: the plotting backend's error.
 pub type DrawError = Box<dyn std::error::Error + Send + Sync>;
 

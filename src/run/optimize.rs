@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::default_output_dir;
-use crate::design::scene_problem;
+use crate::design::{default_solver, scene_problem};
 use crate::report::{cables_csv, write_atomic, write_json};
 use crate::scene::Scene;
 use crate::uniformity::{Design, SolverKind};
@@ -21,14 +21,16 @@ struct DesignFile<'a> {
 }
 
 /// `ringmesh optimize`: one design for the theoretical boundary, written as
-/// `design.json` and `cables.csv` (with cut lengths).
+/// `design.json` and `cables.csv` (with cut lengths); `solver` defaults to
+/// the scene's ([`default_solver`]).
 pub fn optimize(
     scene_path: &Path,
-    solver: SolverKind,
+    solver: Option<SolverKind>,
     output_dir: Option<&Path>,
 ) -> Result<(Design, Vec<PathBuf>), Error> {
     let scene = Scene::read(scene_path)?;
     let (mesh, problem) = scene_problem(&scene)?;
+    let solver = solver.unwrap_or_else(|| default_solver(&scene));
     let design = solver.build(None).solve(&problem)?.feasible()?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     let csv = cables_csv(&mesh.network, &design, &scene.cables);

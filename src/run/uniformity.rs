@@ -45,10 +45,11 @@ pub struct UniformityOutput {
 /// positions are the prescribed geometry. `groups`: the uniformity set is their
 /// union (default `front` when the file has groups, else every cable);
 /// `mean_tension_n`: its target (default: the mean tension of the file's `q`);
-/// `max_force_density_n_per_m`: the bound `[q]` on every cable (may be infinite).
+/// `max_force_density_n_per_m`: the bound `[q]` on every cable (may be infinite);
+/// `solver` defaults to [`SolverKind::default_for`] one unloaded set (`lp`).
 pub fn uniformity(
     network_path: &Path,
-    solver: SolverKind,
+    solver: Option<SolverKind>,
     groups: Option<&[String]>,
     mean_tension_n: Option<f64>,
     max_force_density_n_per_m: f64,
@@ -104,6 +105,7 @@ pub fn uniformity(
         SurfaceTarget::Prescribed,
         max_force_density_n_per_m,
     )?;
+    let solver = solver.unwrap_or_else(|| SolverKind::default_for(1, problem.has_loads()));
     let design = solver.build(None).solve(&problem)?.feasible()?;
     let output = UniformityOutput {
         ratio: design.ratio,

@@ -54,7 +54,7 @@ pub use aperture::{
 };
 pub use pareto::pareto_optimal;
 
-use crate::design::SceneNets;
+use crate::design::{default_solver, SceneNets};
 use crate::design::{LoopSettings, LoopTermination};
 use crate::scene::{Scene, TrussModel, MAX_ELEMENTS_PER_ROD};
 use crate::shard::Shard;
@@ -291,12 +291,13 @@ pub fn baseline(scene: &Scene) -> RunSettings {
         elements_per_rod: scene.truss.elements_per_rod,
         rings: scene.front_net.rings,
         truss: scene.effects.truss,
-        solver: SolverKind::Lp,
+        solver: default_solver(scene),
     }
 }
 
 /// The finest settings: the tightest tolerance and the most elements per rod
-/// of the sweep and the baseline, the exact truss, `lp`, the scene's net.
+/// of the sweep and the baseline, the exact truss, the scene's default
+/// solver, the scene's net.
 pub fn reference(scene: &Scene, settings: &StudySettings) -> RunSettings {
     let base = baseline(scene);
     RunSettings {
@@ -312,7 +313,7 @@ pub fn reference(scene: &Scene, settings: &StudySettings) -> RunSettings {
             .fold(base.elements_per_rod, usize::max),
         rings: base.rings,
         truss: TrussModel::Exact,
-        solver: SolverKind::Lp,
+        solver: default_solver(scene),
     }
 }
 

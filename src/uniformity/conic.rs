@@ -218,15 +218,27 @@ pub(crate) struct ConicOutcome {
 
 impl ConicOutcome {
     /// A reduced-accuracy status (`Almost…`) or a retried solve, for the design's
-    /// warnings.
+    /// warnings, with what the user can check and do about it.
     pub(crate) fn warning(&self, context: &str) -> Option<String> {
         let retried = if self.retried {
             " after a numerical failure and retry"
         } else {
             ""
         };
-        (self.status.starts_with("Almost") || self.retried)
-            .then(|| format!("{context}: clarabel status {}{retried}", self.status))
+        let advice = if self.status.starts_with("Almost") {
+            " (solved only to clarabel's reduced tolerances, gap and residuals about 1e-4 relative: check the \
+             design's max residual and surface RMS; force densities spread over many decades \
+             or a bound [q] far above the design's are the usual cause, and another solver \
+             (--solver) a cross-check)"
+        } else {
+            ""
+        };
+        (self.status.starts_with("Almost") || self.retried).then(|| {
+            format!(
+                "{context}: clarabel status {}{retried}{advice}",
+                self.status
+            )
+        })
     }
 }
 

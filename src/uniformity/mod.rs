@@ -164,6 +164,19 @@ pub enum SolverKind {
 }
 
 impl SolverKind {
+    /// The default solver of a problem with `sets` uniformity sets, loaded
+    /// (`loaded`: nodal loads such as the cables' weight) or not: [`Lp`] —
+    /// one LP, a unique design, the fastest route — where it applies (one set,
+    /// no loads), [`Bisection`] where it does not. Every command that takes
+    /// `--solver` defaults to this rule.
+    pub fn default_for(sets: usize, loaded: bool) -> SolverKind {
+        if sets == 1 && !loaded {
+            SolverKind::Lp
+        } else {
+            SolverKind::Bisection
+        }
+    }
+
     /// The solver with its default settings, or with its accuracy knob set.
     pub fn build(self, knob: Option<f64>) -> Box<dyn UniformitySolver> {
         match self {
