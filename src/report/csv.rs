@@ -10,6 +10,8 @@ use crate::sizing::SectionTrial;
 use crate::study::{value_name, ApertureResult, Knob, RunSettings, StudyRow};
 use crate::uniformity::{Design, FrontPoint, SolverKind};
 
+use super::{decimal, readable};
+
 /// `id,group,i,j,q,tension_n,length_m,cut_length_m`: one row per cable, with the
 /// unstressed cut length `L0 = ℓ/(1 + T/EA)` (DESIGN §7).
 ///
@@ -29,10 +31,10 @@ pub fn cables_csv(network: &Network, design: &Design, cables: &Cables) -> String
             s,
             "{k},{},{i},{j},{},{},{},{}",
             network.group_of(k),
-            super::decimal(design.q[k], 13),
-            super::decimal(t, 13),
-            super::decimal(l, 13),
-            super::decimal(cables.cut_length_m(l, t), 13)
+            decimal(design.q[k], 13),
+            decimal(t, 13),
+            decimal(l, 13),
+            decimal(cables.cut_length_m(l, t), 13)
         );
     }
     s
@@ -72,8 +74,12 @@ pub const FRONT_COLUMNS: &str = "solver,knob,ratio,rms_mm,time_s";
 /// One line of `front.csv` (without its newline).
 pub fn front_row(row: &FrontRow) -> String {
     format!(
-        "{},{:e},{:.10e},{:.6e},{:.6e}",
-        row.solver, row.knob, row.ratio, row.rms_mm, row.time_s
+        "{},{},{},{},{}",
+        row.solver,
+        readable(row.knob, 7),
+        readable(row.ratio, 11),
+        readable(row.rms_mm, 7),
+        readable(row.time_s, 7)
     )
 }
 
@@ -108,22 +114,22 @@ pub const STUDY_COLUMNS: &str = "knob,value,tolerance_m,elements_per_rod,rings,t
 pub fn study_row(r: &StudyRow) -> String {
     let g = |v: f64| {
         if v.is_finite() {
-            format!("{v:.6e}")
+            readable(v, 7)
         } else {
             String::new()
         }
     };
     let s = &r.settings;
     format!(
-        "{},{},{:e},{},{},{},{},{:.4e},{},{},{},{},{},{},{},{},{},{},{},{}",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
         r.knob.name(),
         r.value,
-        s.tolerance_m,
+        readable(s.tolerance_m, 7),
         s.elements_per_rod,
         s.rings,
         value_name(&s.truss),
         value_name(&s.solver),
-        r.time_s,
+        readable(r.time_s, 5),
         r.outer_iterations.map_or(String::new(), |n| n.to_string()),
         r.termination.map_or(String::new(), |t| json_name(&t)),
         g(r.boundary_residual_m),
@@ -313,17 +319,17 @@ pub fn sizing_csv(trials: &[SectionTrial]) -> String {
         let c = &t.section;
         let _ = writeln!(
             s,
-            "{:.7},{:.7},{:e},{},{:.6e},{:.6},{},{},{},{},{},{:.3},{}",
+            "{:.7},{:.7},{},{},{},{:.6},{},{},{},{},{},{:.3},{}",
             c.outer_diameter_m,
             c.inner_diameter_m,
-            c.youngs_modulus_pa,
-            c.density_kg_per_m3,
-            t.mass_kg,
+            readable(c.youngs_modulus_pa, 7),
+            readable(c.density_kg_per_m3, 7),
+            readable(t.mass_kg, 7),
             t.margin,
             t.bound.map_or("", |b| b.kind()),
             t.outer_iterations,
             t.termination.map_or(String::new(), |t| json_name(&t)),
-            t.rms_mm.map_or(String::new(), |v| format!("{v:.6e}")),
+            t.rms_mm.map_or(String::new(), |v| readable(v, 7)),
             t.carries,
             t.time_s,
             t.failure.as_deref().map_or(String::new(), quote),
@@ -345,27 +351,26 @@ pub fn aperture_csv(results: &[ApertureResult]) -> String {
         for m in &r.models {
             let _ = writeln!(
                 s,
-                "{},{},{},{:.7},{:.7},{:.6e},{:.6},{},{:.3},{:.6e},{},{},{:.10e},{},{:.6e},\
-                 {:.6e},{:.6e},{:.6e},{:.6e},{},{:.3},{:.3}",
+                "{},{},{},{:.7},{:.7},{},{:.6},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{:.3},{:.3}",
                 r.aperture_m,
                 r.rings,
                 r.nodes,
                 r.section.outer_diameter_m,
                 r.section.inner_diameter_m,
-                r.truss_mass_kg,
+                readable(r.truss_mass_kg, 7),
                 r.margin,
                 r.sizing_designs,
                 r.sizing_time_s,
-                r.hinge_motion_mm,
+                readable(r.hinge_motion_mm, 7),
                 value_name(&m.model),
                 m.outer_iterations,
-                m.ratio,
+                finite(m.ratio),
                 finite(m.built_ratio),
-                m.rms_mm,
-                m.max_deviation_mm,
-                m.tension_change_pct,
-                m.cut_length_error_mm,
-                m.boundary_deviation_mm,
+                readable(m.rms_mm, 7),
+                readable(m.max_deviation_mm, 7),
+                readable(m.tension_change_pct, 7),
+                readable(m.cut_length_error_mm, 7),
+                readable(m.boundary_deviation_mm, 7),
                 m.slack_cables,
                 m.design_time_s,
                 m.assembly_time_s,
@@ -375,10 +380,10 @@ pub fn aperture_csv(results: &[ApertureResult]) -> String {
     s
 }
 
-/// A number, or nothing when it is not finite.
+/// A ratio (11 significant digits), or nothing when it is not finite.
 fn finite(v: f64) -> String {
     if v.is_finite() {
-        format!("{v:.10e}")
+        readable(v, 11)
     } else {
         String::new()
     }
@@ -394,18 +399,18 @@ pub fn convergence_csv(runs: &[LoopRun]) -> String {
         for r in &run.history {
             let _ = writeln!(
                 s,
-                "{},{},{:e},{:e},{},{:.12e},{:e},{},{:e},{:e},{:e}",
+                "{},{},{},{},{},{},{},{},{},{},{}",
                 run.relaxation.name(),
                 r.iteration,
-                r.boundary_change_max_m,
-                r.boundary_change_rms_m,
-                r.xi_change_m.map_or(String::new(), |v| format!("{v:e}")),
-                r.ratio,
-                r.relaxation_factor,
+                readable(r.boundary_change_max_m, 7),
+                readable(r.boundary_change_rms_m, 7),
+                r.xi_change_m.map_or(String::new(), |v| readable(v, 7)),
+                readable(r.ratio, 13),
+                readable(r.relaxation_factor, 7),
                 r.oracle_newton_iterations,
-                r.design_time_s,
-                r.truss_time_s,
-                r.elapsed_s
+                readable(r.design_time_s, 7),
+                readable(r.truss_time_s, 7),
+                readable(r.elapsed_s, 7)
             );
         }
     }
