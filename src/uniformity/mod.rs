@@ -139,6 +139,17 @@ pub trait UniformitySolver: Send + Sync {
     /// design with [`Termination::Infeasible`] (the reason in its warnings),
     /// not an error; an error is invalid input or a failure.
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError>;
+    /// Solves from `start`, the design of a neighbouring problem (the
+    /// previous outer iteration's boundary, the neighbouring knob of a front):
+    /// an iterative solver begins there, so that its answer moves smoothly
+    /// with the problem; the others solve afresh.
+    fn solve_from(
+        &self,
+        problem: &UniformityProblem,
+        _start: &Design,
+    ) -> Result<Design, UniformityError> {
+        self.solve(problem)
+    }
     /// True when the design is a unique, continuous function of the problem;
     /// false for min-ratio programs, whose optimum is a face (see
     /// [`most_uniform`] for a unique point of it).

@@ -1,0 +1,509 @@
+//! Free-geometry gradient solver (DESIGN §4): forward FDM from `q` with no
+//! prescribed positions, a smooth penalty objective, its adjoint gradient
+//! (DESIGN §3), and argmin's L-BFGS with a More–Thuente line search.
+//!
+//! # Objective
+//!
+//! Variables `θ` (one per cable) map smoothly onto the box of force densities,
+//!
+//! $$q_k = q_0 + ([q] − q_0)\,σ(θ_k), \qquad σ(θ) = 1/(1 + e^{−θ}),$$
+//!
+//! so `q_0 < q < [q]` for every `θ` (`q_0 = 10⁻⁹ [q]` keeps `D` numerically
+//! positive definite); for `q ≪ [q]`, `θ ≈ ln(q/[q])`. The objective is
+//!
+//! $$J = \frac{1}{n_s L^2}\Big(\sum_{i\in\text{surf}} e_i^2 + λ_{\text{lay}}
+//!   \sum_i d_i^2\Big) + w \sum_g R_g(T) + κ \ln^2\frac{\bar T_0}{t_0} + ν B(q)$$
+//!
+//! * **surface**: `e_i = z_i − (x_i² + y_i²)/(4F)` at every surface node for a
+//!   paraboloid target, `|x_i − x̂_i|` for a prescribed one; `L` is the mean
+//!   design length of the first set's cables and `n_s` the number of surface
+//!   nodes, so the term is a dimensionless mean square;
+//! * **layout** (`λ_lay` = [`Gradient::layout_weight`]): `d_i` is the plan drift
+//!   of a surface node from its design position (paraboloid target) and the 3-D
+//!   drift of every other free node (rear net). Without it the problem is not
+//!   the one the fixed-geometry solvers solve: the front net slides in plan to
+//!   an equal-tension layout on the paraboloid (on `small-hex`, `Tmax/Tmin` = 1.000
+//!   with 0.19 m of plan drift), or the rear nodes move so that tilted ties
+//!   balance any front-net tension;
+//! * **ratio surrogate**: `R_g = smax_β(s) − smin_β(s)` over the set's
+//!   `s_k = ln T_k`, with the normalised log-sum-exp
+//!   `smax_β(s) = (1/β) ln((1/n) Σ e^{β s_k})` and `smin_β(s) = −smax_β(−s)`:
+//!   smooth, below `ln(Tmax/Tmin)` by at most `2 ln(n)/β`, equal to it as the
+//!   sharpness `β → ∞`;
+//! * **level**: a homogeneous network's shape is invariant under `q → c q`, so
+//!   without a level term the minimum is a ray, not a point;
+//! * **bound barrier** `B = Σ_k (ln(q̲_k/q_k))₊³ + (ln(q_k/q̄))₊³`, C², zero inside
+//!   the box `T_k ≥ f t_0` (at design lengths; `f` the problem's
+//!   `min_tension_fraction`) and `q_k ≤ 0.99 [q]`, where the map does not
+//!   saturate.
+//!
+//! `T_k = q_k ℓ_k(x(q))`: the tension terms enter `∂J/∂q` through `q_k` and
+//! `∂J/∂x` through `ℓ_k`; one adjoint solve with the factor of the forward solve
+//! turns `∂J/∂x` into `dJ/dq` ([`crate::Equilibrium::sensitivities`]).
+//!
+//! The weight `w` is the accuracy knob: the surface error of the minimiser grows
+//! in proportion to `w`.
+//!
+//! # Solver
+//!
+//! In `θ` the problem is badly conditioned: about the design geometry the surface
+//! term is `‖D⁻¹ A(x̂) δq‖²` (`A(x̂)` the equilibrium matrix of the design
+//! geometry), so its curvature spreads like the square of `D`'s spectrum, and
+//! the ratio term along the self-stresses is `w` times flatter again; plain
+//! L-BFGS on `θ` ([`Gradient::precondition`] `= false`) needs thousands of
+//! iterations on the small test scenes. L-BFGS therefore runs in preconditioned
+//! variables `φ = (ψ, b)`, linearised around the `q_r` at which a run starts:
+//!
+//! $$q = q_r ∘ c(1 + Δ), \qquad Δ = ψ + W B^⊤ K^{-1}(D_r b − B ψ),$$
+//!
+//! with `B = A(x̂) diag(q_r)`, `K = B W Bᵀ` (one sparse Cholesky factorisation per
+//! run), `D_r = D(q_r)`, and `W = diag(1 on set cables, 10⁴ elsewhere)`, so that
+//! ties, boundary and rear cables absorb residual changes and the set cables
+//! stay the design variables. `c` is the identity on `[1/4, ~[q]/q_r]`,
+//! continued smoothly towards 0 below and towards `[q]` above: every iterate
+//! keeps `0 < q < [q]`. Equilibrium at the design geometry is affine in `q`:
+//! `ψ` moves only along its self-stresses, and `b` changes its residual by
+//! `D_r b`, which displaces the free nodes by about `−b`; the surface term is
+//! then about `‖b‖²`, and the layout of `q` no longer matters. The objective
+//! is the same; only L-BFGS's coordinates change.
+//!
+//! A run ends after [`Gradient::restart_iterations`] iterations, at a line
+//! search that cannot go on, or at the gradient test; the next run
+//! re-linearises. The sharpness starts at [`Gradient::initial_sharpness`] and
+//! grows ×3 per run up to [`Gradient::sharpness`] (a smooth surrogate first, the
+//! sharp one at the end). At the final sharpness the solve has converged when
+//! `‖dJ/dθ‖` (checked at every accepted iterate) falls below
+//! [`Gradient::gradient_tolerance`] times its value at the network's `q`, or when
+//! a whole run lowers `J` by no more than [`Gradient::cost_tolerance`]`·|J|`.
+//! Terminations: `Converged` (either test), `MaxIterations`, `Stalled` (a line
+//! search that failed in the last run), `NumericalError` (a forward solve
+//! failed: the best point so far is returned).
+//!
+//! The start is the uniform-tension guess (`T = t_g` on the set cables at
+//! design lengths, the network's `q` elsewhere) moved onto equilibrium at the
+//! design geometry by damped Gauss–Newton steps in `θ` (a handful of sparse
+//! solves), then scaled to the target level.
+
+mod lbfgs;
+mod map;
+mod objective;
+mod preconditioner;
+mod start;
+
+use std::time::Instant;
+
+use super::{Design, KnobRange, Termination, UniformityError, UniformityProblem, UniformitySolver};
+use lbfgs::{minimise, Variables};
+use map::Map;
+use objective::Objective;
+use preconditioner::Preconditioner;
+use start::projected_start;
+
+/// Growth of the sharpness per restart.
+const SHARPNESS_GROWTH: f64 = 3.0;
+
+/// Adjoint-gradient L-BFGS on the free geometry (see the module documentation).
+#[derive(Debug, Clone)]
+pub struct Gradient {
+    /// Weight `w` of the ratio surrogate against the surface error: larger buys a
+    /// lower `Tmax/Tmin` with a larger surface error (the design-front knob).
+    pub weight: f64,
+    /// Weight of the layout drift against the surface error (0: free layout).
+    pub layout_weight: f64,
+    /// Sharpness `β` of the soft max/min of `ln T`: larger follows `Tmax/Tmin`
+    /// more closely and makes the objective stiffer.
+    pub sharpness: f64,
+    /// Sharpness of the first L-BFGS run; it grows ×3 per restart up to
+    /// `sharpness` (continuation: smooth first, sharp at the end).
+    pub initial_sharpness: f64,
+    /// Weight `κ` of the pretension-level term `ln²(T̄₀/t₀)`.
+    pub level_weight: f64,
+    /// Weight `ν` of the bound barrier.
+    pub barrier_weight: f64,
+    /// Number of correction pairs L-BFGS keeps.
+    pub memory: usize,
+    /// Most L-BFGS iterations in all.
+    pub max_iterations: usize,
+    /// Most iterations of one L-BFGS run; then the preconditioner is
+    /// re-linearised around the current point, the sharpness raised, and L-BFGS
+    /// restarted.
+    pub restart_iterations: usize,
+    /// Converged (at the final sharpness) when the stationarity
+    /// `‖dJ/dθ‖∞ / J` falls to this: scale-free, and independent of the start.
+    pub gradient_tolerance: f64,
+    /// Converged (at the final sharpness) when a whole L-BFGS run lowers `J` by
+    /// no more than `cost_tolerance · |J|`.
+    pub cost_tolerance: f64,
+    /// Precondition L-BFGS (see the module documentation); `false` runs it on `θ`.
+    pub precondition: bool,
+    /// Start from the uniform-tension guess projected onto equilibrium at the
+    /// design geometry; `false` starts from the network's `q`.
+    pub project_start: bool,
+}
+
+impl Default for Gradient {
+    fn default() -> Self {
+        Gradient {
+            weight: 1e-6,
+            layout_weight: 1.0,
+            sharpness: 1000.0,
+            initial_sharpness: 10.0,
+            level_weight: 1.0,
+            barrier_weight: 1.0,
+            memory: 20,
+            max_iterations: 5000,
+            restart_iterations: 300,
+            gradient_tolerance: 1e-3,
+            cost_tolerance: 1e-12,
+            precondition: true,
+            project_start: true,
+        }
+    }
+}
+
+impl Gradient {
+    /// Checks the settings.
+    pub fn validate(&self) -> Result<(), UniformityError> {
+        let bad = |name: &'static str, value: f64, range: &'static str| {
+            Err(UniformityError::Setting {
+                solver: "gradient",
+                name,
+                value,
+                range,
+            })
+        };
+        let non_negative = [
+            ("weight", self.weight),
+            ("layout_weight", self.layout_weight),
+            ("barrier_weight", self.barrier_weight),
+            ("gradient_tolerance", self.gradient_tolerance),
+            ("cost_tolerance", self.cost_tolerance),
+        ];
+        for (what, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(what, v, "finite and ≥ 0");
+            }
+        }
+        for (what, v) in [
+            ("sharpness", self.sharpness),
+            ("initial_sharpness", self.initial_sharpness),
+            ("level_weight", self.level_weight),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(what, v, "finite and > 0");
+            }
+        }
+        if self.memory == 0 {
+            return bad("memory", 0.0, "≥ 1");
+        }
+        if self.restart_iterations == 0 {
+            return bad("restart_iterations", 0.0, "≥ 1");
+        }
+        Ok(())
+    }
+
+    /// The objective `J(θ)` and its gradient `dJ/dθ` (adjoint, through the map).
+    ///
+    /// `theta`: n_edges.
+    pub fn objective_and_gradient(
+        &self,
+        problem: &UniformityProblem,
+        theta: &[f64],
+    ) -> Result<(f64, Vec<f64>), UniformityError> {
+        self.validate()?;
+        let m = problem.network().n_edges();
+        if theta.len() != m {
+            return Err(UniformityError::invalid(
+                "theta",
+                format!("{} entries, expected {m}", theta.len()),
+            ));
+        }
+        Objective::new(self, problem).evaluate_theta(theta)
+    }
+
+    /// The force densities of `theta` (n_edges), N/m.
+    pub fn q_of_theta(&self, problem: &UniformityProblem, theta: &[f64]) -> Vec<f64> {
+        let map = Map::new(problem);
+        theta.iter().map(|&t| map.q(t)).collect()
+    }
+
+    /// The variables of `q` (n_edges, N/m), each clamped into the map's range.
+    pub fn theta_of_q(&self, problem: &UniformityProblem, q: &[f64]) -> Vec<f64> {
+        let map = Map::new(problem);
+        q.iter().map(|&v| map.theta(v)).collect()
+    }
+
+    /// Solves, and returns the design with the objective and gradient norm of
+    /// every accepted iterate.
+    pub fn solve_with_history(
+        &self,
+        problem: &UniformityProblem,
+    ) -> Result<(Design, History), UniformityError> {
+        self.solve_history_from(problem, None)
+    }
+
+    /// [`Gradient::solve_with_history`] from the force densities `start`
+    /// (a neighbouring problem's design: the previous outer iteration's, the
+    /// neighbouring weight's), or from the projected uniform-tension guess.
+    pub fn solve_history_from(
+        &self,
+        problem: &UniformityProblem,
+        start: Option<&[f64]>,
+    ) -> Result<(Design, History), UniformityError> {
+        let clock = Instant::now();
+        self.validate()?;
+        let objective = Objective::new(self, problem);
+        let mut warnings = Vec::new();
+        let m = problem.network().n_edges();
+        let warm = start.filter(|q| q.len() == m && q.iter().all(|v| v.is_finite() && *v > 0.0));
+        let mut q = match warm {
+            Some(q) => q.to_vec(),
+            None if self.project_start => {
+                projected_start(problem, &objective.map).unwrap_or_else(|e| {
+                    warnings.push(format!(
+                        "projected start failed ({e}); starting from the network's q"
+                    ));
+                    problem.network().q.clone()
+                })
+            }
+            None => problem.network().q.clone(),
+        };
+        // Into the map's range, as the solver's iterates are.
+        q = self.q_of_theta(problem, &self.theta_of_q(problem, &q));
+
+        let (j, g) = objective.evaluate_q(&q)?;
+        let stationarity = objective.stationarity(&q, j, &g);
+        let mut history = History {
+            objective: vec![j],
+            gradient_norm: vec![objective.theta_gradient_norm(&q, &g)],
+            stationarity,
+            evaluations: 1,
+            runs: 0,
+        };
+        // A warm start begins at the final sharpness: its point is already
+        // near the sharp problem's minimiser, and a smooth stage would pull
+        // it away first.
+        let first_sharpness = if warm.is_some() {
+            self.sharpness
+        } else {
+            self.initial_sharpness.min(self.sharpness)
+        };
+        let mut termination = if stationarity <= self.gradient_tolerance {
+            Termination::Converged
+        } else {
+            Termination::MaxIterations
+        };
+        let mut iterations = 0;
+        while termination != Termination::Converged && iterations < self.max_iterations {
+            let preconditioner = if self.precondition {
+                match Preconditioner::new(problem, &q) {
+                    Ok(p) => Some(p),
+                    Err(e) => {
+                        warnings.push(format!("no preconditioner ({e}); plain θ variables"));
+                        None
+                    }
+                }
+            } else {
+                None
+            };
+            let budget = self
+                .restart_iterations
+                .min(self.max_iterations - iterations);
+            let sharpness =
+                (first_sharpness * SHARPNESS_GROWTH.powi(history.runs as i32)).min(self.sharpness);
+            let objective = objective.with_sharpness(sharpness);
+            let before = objective.evaluate_q(&q)?.0;
+            history.evaluations += 1;
+            let variables = Variables::new(&objective, preconditioner.as_ref(), &q);
+            let run = minimise(
+                &variables,
+                self.memory,
+                budget,
+                self.gradient_tolerance,
+                &mut history,
+            )?;
+            history.runs += 1;
+            iterations += run.iterations;
+            warnings.extend(run.warnings);
+            q = run.q;
+            termination = run.termination;
+            let (after, g) = objective.evaluate_q(&q)?;
+            history.stationarity = objective.stationarity(&q, after, &g);
+            history.evaluations += 1;
+            if matches!(termination, Termination::NumericalError) {
+                break;
+            }
+            if sharpness < self.sharpness {
+                termination = Termination::MaxIterations;
+                continue;
+            }
+            // Objective change over a whole run (restart_iterations iterations, or
+            // up to a line search that could not go on).
+            if before - after <= self.cost_tolerance * after.abs() {
+                termination = Termination::Converged;
+            }
+        }
+        let design = Design::evaluate(
+            problem,
+            self.name(),
+            q,
+            termination,
+            iterations,
+            clock.elapsed(),
+            warnings,
+        )?;
+        Ok((self.certified(problem, design, clock)?, history))
+    }
+
+    /// `design`, or [`Termination::Infeasible`] when it holds the shape only
+    /// by letting a cable go slack (a tension below the barrier's floor,
+    /// `min_tension_fraction` of the target) and the geometry has no strictly
+    /// positive equilibrium (the slack analysis names the nodes; when it has
+    /// one, the design stays, with a warning).
+    fn certified(
+        &self,
+        problem: &UniformityProblem,
+        mut design: Design,
+        clock: Instant,
+    ) -> Result<Design, UniformityError> {
+        let floor = problem.min_other_tension_n();
+        let Some(k) = (0..design.q.len()).find(|&k| design.tensions_n[k] < floor) else {
+            return Ok(design);
+        };
+        let slack = super::conic::slack_nodes(problem)?;
+        if slack.count > 0 {
+            let mut warnings = std::mem::take(&mut design.warnings);
+            warnings.push(format!(
+                "cable {k} holds {:.3e} N, below the floor {floor:.3e} N: the shape needs slack cables",
+                design.tensions_n[k]
+            ));
+            return super::conic::infeasible_design(
+                problem,
+                self.name(),
+                design.iterations,
+                clock,
+                warnings,
+            );
+        }
+        design.warnings.push(format!(
+            "cable {k} holds {:.3e} N, below the floor {floor:.3e} N, though strictly positive \
+             force densities balance the geometry: the solve did not find them",
+            design.tensions_n[k]
+        ));
+        design.termination = Termination::Stalled;
+        Ok(design)
+    }
+}
+
+/// Objective value and gradient norm of every accepted iterate.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct History {
+    /// The stationarity `‖dJ/dθ‖∞ / J` at the end (the convergence test).
+    pub stationarity: f64,
+    /// `J` at the start and after every iteration (each run at its own
+    /// sharpness, the start at the final one).
+    pub objective: Vec<f64>,
+    /// `‖dJ/dθ‖` at the same points.
+    pub gradient_norm: Vec<f64>,
+    /// Evaluations of `J` and its gradient (forward + adjoint solves).
+    pub evaluations: usize,
+    /// L-BFGS runs (the preconditioner is re-linearised for each).
+    pub runs: usize,
+}
+
+impl UniformitySolver for Gradient {
+    fn name(&self) -> &'static str {
+        "gradient"
+    }
+
+    /// The ratio weight from 1e-8 to 1: the surface term is normalised, so
+    /// 1e-6 is already near the exact-equilibrium design.
+    fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
+        Some(KnobRange {
+            name: "weight",
+            exact: None,
+            low: 1e-8,
+            high: 1.0,
+        })
+    }
+
+    fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
+        self.solve_with_history(problem).map(|(design, _)| design)
+    }
+
+    fn solve_from(
+        &self,
+        problem: &UniformityProblem,
+        start: &Design,
+    ) -> Result<Design, UniformityError> {
+        self.solve_history_from(problem, Some(&start.q))
+            .map(|(design, _)| design)
+    }
+}
+
+/// Problems the unit tests of the solver's parts share.
+#[cfg(test)]
+mod fixtures {
+    use std::path::Path;
+
+    use crate::geometry::build_mesh;
+    use crate::scene::Scene;
+    use crate::uniformity::UniformityProblem;
+    use crate::CableGroup;
+
+    pub fn small_hex() -> UniformityProblem {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml");
+        let scene = Scene::read(&path).unwrap();
+        let mesh = build_mesh(&scene).unwrap();
+        UniformityProblem::from_mesh(
+            &mesh,
+            &[(CableGroup::Front, scene.front_net.mean_tension_n)],
+            scene.cables.max_force_density_n_per_m,
+        )
+        .unwrap()
+    }
+
+    /// A deterministic spread of values in `[-1, 1]`.
+    pub fn pattern(n: usize, seed: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| (((i * 7919 + seed * 104_729) % 201) as f64 - 100.0) / 100.0)
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uniformity::gradient::fixtures::small_hex;
+
+    #[test]
+    fn invalid_settings_are_rejected() {
+        let problem = small_hex();
+        for bad in [
+            Gradient {
+                weight: -1.0,
+                ..Gradient::default()
+            },
+            Gradient {
+                sharpness: 0.0,
+                ..Gradient::default()
+            },
+            Gradient {
+                memory: 0,
+                ..Gradient::default()
+            },
+        ] {
+            assert!(matches!(
+                bad.solve(&problem),
+                Err(UniformityError::Setting {
+                    solver: "gradient",
+                    ..
+                })
+            ));
+        }
+        let theta = vec![0.0; 3];
+        assert!(Gradient::default()
+            .objective_and_gradient(&problem, &theta)
+            .is_err());
+    }
+}
