@@ -6,8 +6,8 @@ mod common;
 
 use ringmesh::geometry::build_mesh;
 use ringmesh::uniformity::{
-    Bisection, Design, Lp, SurfaceTarget, Termination, UniformityError, UniformityProblem,
-    UniformitySet, UniformitySolver,
+    Bisection, Design, Gradient, Lp, SurfaceTarget, Termination, UniformityError,
+    UniformityProblem, UniformitySet, UniformitySolver,
 };
 use ringmesh::CableGroup;
 
@@ -172,7 +172,8 @@ fn boundary_node_on_a_straight_chord_is_reported_infeasible_by_name() {
     mesh.network.nodes[rear][1] = y;
     let problem =
         UniformityProblem::from_mesh(&mesh, &[(CableGroup::Front, 70.0)], 5000.0).unwrap();
-    let solvers: [&dyn UniformitySolver; 2] = [&Lp, &Bisection::default()];
+    let gradient = Gradient::default();
+    let solvers: [&dyn UniformitySolver; 3] = [&Lp, &Bisection::default(), &gradient];
     for solver in solvers {
         // Infeasibility is a design's termination; a caller that needs a
         // design gets it as the error naming the nodes.

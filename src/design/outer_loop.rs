@@ -194,9 +194,14 @@ pub fn design_loop_with(
     let mut x = flatten(oracle.attachments());
     let mut history: Vec<IterationRecord> = Vec::new();
     let mut initial: Option<TiedDesign> = None;
+    // The last boundary's design: each design starts from it, so that an
+    // iterative solver's answer moves smoothly with the boundary.
+    let mut previous: Option<TiedDesign> = None;
     for iteration in 0..settings.max_iterations {
         let uniformity = |source| DesignError::Uniformity { iteration, source };
-        let tied = nets.design(solver, &unflatten(&x)).map_err(uniformity)?;
+        let tied = nets
+            .design_from(solver, &unflatten(&x), previous.as_ref())
+            .map_err(uniformity)?;
         let design = &tied.design;
         if !matches!(
             design.termination,
@@ -261,7 +266,10 @@ pub fn design_loop_with(
                 time_s: clock.elapsed().as_secs_f64(),
             });
         }
-        initial.get_or_insert(tied);
+        if initial.is_none() {
+            initial = Some(tied.clone());
+        }
+        previous = Some(tied);
         x = step.x;
     }
     unreachable!("the loop returns at its last iteration")

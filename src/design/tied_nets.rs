@@ -102,6 +102,9 @@ pub struct TiedDesign {
     pub problem: UniformityProblem,
     /// The rear level `α = q_rear/q_front` of the mirror.
     pub alpha: f64,
+    /// The first stage's design (front net and ties): the start of the next
+    /// boundary's ([`TiedNets::design_from`]).
+    pub front: Design,
 }
 
 impl TiedNets {
@@ -232,6 +235,20 @@ impl TiedNets {
         solver: &dyn UniformitySolver,
         boundary_m: &[[f64; 3]],
     ) -> Result<TiedDesign, UniformityError> {
+        self.design_from(solver, boundary_m, None)
+    }
+
+    /// [`TiedNets::design`] with the first stage started from `start`'s
+    /// (a neighbouring boundary's design: [`UniformitySolver::solve_from`]).
+    ///
+    /// # Errors
+    /// As [`TiedNets::design`].
+    pub fn design_from(
+        &self,
+        solver: &dyn UniformitySolver,
+        boundary_m: &[[f64; 3]],
+        start: Option<&TiedDesign>,
+    ) -> Result<TiedDesign, UniformityError> {
         let clock = Instant::now();
         let network = self.full.network();
         if boundary_m.len() != network.fixed.len() {
@@ -265,7 +282,12 @@ impl TiedNets {
         let mut passes = 0;
         let (front_design, q, alpha) = loop {
             passes += 1;
-            let (front_design, q, alpha) = self.stages(solver, &mut whole, weights.as_deref())?;
+            let (front_design, q, alpha) = self.stages(
+                solver,
+                &mut whole,
+                weights.as_deref(),
+                start.map(|s| &s.front),
+            )?;
             let Some(new) = self.effects.net_loads_n(&whole, &network.edges) else {
                 break (front_design, q, alpha);
             };
@@ -287,12 +309,13 @@ impl TiedNets {
             front_design.termination,
             front_design.iterations,
             clock.elapsed(),
-            front_design.warnings,
+            front_design.warnings.clone(),
         )?;
         Ok(TiedDesign {
             design,
             problem,
             alpha,
+            front: front_design,
         })
     }
 
@@ -304,6 +327,7 @@ impl TiedNets {
         solver: &dyn UniformitySolver,
         whole: &mut [[f64; 3]],
         weights: Option<&[[f64; 3]]>,
+        start: Option<&Design>,
     ) -> Result<(Design, Vec<f64>, f64), UniformityError> {
         let network = self.full.network();
         let (n_front, n) = (self.n_front, self.n_front_cables);
@@ -319,7 +343,11 @@ impl TiedNets {
             .front
             .with_positions(front_nodes)?
             .with_loads(front_loads)?;
-        let mut front_design = solver.solve(&front)?.feasible()?;
+        let mut front_design = match start {
+            Some(start) => solver.solve_from(&front, start),
+            None => solver.solve(&front),
+        }?
+        .feasible()?;
         if !solver.unique_design() {
             // A point of the optimal face that moves continuously with C.
             let bounds: Vec<f64> = front_design

@@ -101,41 +101,74 @@ pub fn design_front(
     design_front_points(problem, &front_jobs(problem, solvers, points), on_point)
 }
 
-/// Designs the front's points `jobs` in parallel, returned in their order;
-/// `on_point` is called as each finishes (from worker threads).
+/// Designs the front's points `jobs`, returned in their order; `on_point` is
+/// called as each finishes (from worker threads). Each run of consecutive
+/// jobs of a solver that [`SolverKind::warm_starts`] is a chain along its
+/// knob (every other job a chain of its own): the chains run in parallel,
+/// and each point of a chain starts from its neighbour's design
+/// ([`super::UniformitySolver::solve_from`]), so that an iterative solver's
+/// front moves smoothly (and monotonically) with its knob.
 pub fn design_front_points(
     problem: &UniformityProblem,
     jobs: &[(SolverKind, f64)],
     on_point: &(dyn Fn(&FrontPoint) + Sync),
 ) -> Vec<FrontPoint> {
-    jobs.par_iter()
-        .map(|&(solver, knob)| {
-            let start = Instant::now();
-            // A point without a feasible design is a failed point, as an error is.
-            let result = solver
-                .build(Some(knob))
-                .solve(problem)
-                .and_then(Design::feasible);
-            let point = match result {
-                Ok(design) => FrontPoint {
-                    solver,
-                    knob,
-                    ratio: design.ratio,
-                    rms_mm: 1e3 * design.surface_rms_m,
-                    time_s: design.time_s,
-                    outcome: Ok(design.termination),
-                },
-                Err(e) => FrontPoint {
-                    solver,
-                    knob,
-                    ratio: f64::NAN,
-                    rms_mm: f64::NAN,
-                    time_s: start.elapsed().as_secs_f64(),
-                    outcome: Err(Arc::new(e)),
-                },
-            };
-            on_point(&point);
-            point
+    let chains: Vec<&[(SolverKind, f64)]> = jobs
+        .chunk_by(|a, b| a.0 == b.0 && a.0.warm_starts())
+        .collect();
+    chains
+        .par_iter()
+        .flat_map_iter(|chain| {
+            let mut previous: Option<Design> = None;
+            let points: Vec<FrontPoint> = chain
+                .iter()
+                .map(|&(solver, knob)| {
+                    let point = front_point(problem, solver, knob, &mut previous);
+                    on_point(&point);
+                    point
+                })
+                .collect();
+            points
         })
         .collect()
+}
+
+/// One point of the front, started from `previous` (a neighbour's design),
+/// which becomes this point's design when it has one.
+fn front_point(
+    problem: &UniformityProblem,
+    solver: SolverKind,
+    knob: f64,
+    previous: &mut Option<Design>,
+) -> FrontPoint {
+    let start = Instant::now();
+    let built = solver.build(Some(knob));
+    // A point without a feasible design is a failed point, as an error is.
+    let result = match previous.as_ref() {
+        Some(neighbour) => built.solve_from(problem, neighbour),
+        None => built.solve(problem),
+    }
+    .and_then(Design::feasible);
+    match result {
+        Ok(design) => {
+            let point = FrontPoint {
+                solver,
+                knob,
+                ratio: design.ratio,
+                rms_mm: 1e3 * design.surface_rms_m,
+                time_s: design.time_s,
+                outcome: Ok(design.termination),
+            };
+            *previous = Some(design);
+            point
+        }
+        Err(e) => FrontPoint {
+            solver,
+            knob,
+            ratio: f64::NAN,
+            rms_mm: f64::NAN,
+            time_s: start.elapsed().as_secs_f64(),
+            outcome: Err(Arc::new(e)),
+        },
+    }
 }

@@ -188,6 +188,13 @@ impl SolverKind {
         }
     }
 
+    /// True for a solver that starts from a neighbouring problem's design
+    /// ([`UniformitySolver::solve_from`]); the others solve every problem
+    /// afresh.
+    pub fn warm_starts(self) -> bool {
+        matches!(self, SolverKind::Gradient)
+    }
+
     /// The solver with its default settings, or with its accuracy knob set.
     pub fn build(self, knob: Option<f64>) -> Box<dyn UniformitySolver> {
         match self {
