@@ -16,7 +16,12 @@
 //!   F/D = 0.4); `RINGMESH_BENCH_FREE=100000` adds ~10⁵-node nets of both
 //!   (20–40 s a solve);
 //! * `gradient_nodes` — the `gradient` solver on the paper scene with 3 rings
-//!   (362 net nodes).
+//!   (362 net nodes);
+//! * `gradient_independent` — the `gradient` solver on the independently
+//!   generated tied nets of `lp_independent`'s `hex5` kind, 428 and 4 208
+//!   nodes (`RINGMESH_BENCH_GRADIENT_RINGS=41,130` adds ≈ 10⁴ and 10⁵); the
+//!   ratio against `lp`'s, the surface RMS and the iterations of one solve
+//!   are printed beside the time.
 //!
 //! Run with `cargo bench --bench uniformity`.
 
@@ -161,12 +166,51 @@ fn gradient_nodes(c: &mut Criterion) {
     group.finish();
 }
 
+/// Rings of the independently generated nets of `gradient_independent`:
+/// 428 and 4 208 nodes by default (issue 17's ~430-node net and the next
+/// decade); `RINGMESH_BENCH_GRADIENT_RINGS=41,130` adds ≈ 10⁴ and 10⁵.
+fn gradient_independent(c: &mut Criterion) {
+    let mut rings = vec![8, 26];
+    if let Ok(extra) = std::env::var("RINGMESH_BENCH_GRADIENT_RINGS") {
+        rings.extend(
+            extra
+                .split(',')
+                .filter_map(|r| r.trim().parse::<usize>().ok()),
+        );
+    }
+    let mut group = c.benchmark_group("gradient_independent");
+    group.sample_size(10);
+    for r in rings {
+        let net = hexnet::HexNet::like_hex5(r);
+        let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
+        let nodes = p.network().n_nodes();
+        let optimum = Lp.solve(&p).map(|d| d.ratio).unwrap_or(f64::NAN);
+        // What a solve reaches, once, beside its time.
+        if let Ok(d) = Gradient::default().solve(&p) {
+            eprintln!(
+                "gradient_independent/{nodes}: ratio {:.4} ({:+.2} % of lp's {optimum:.4}), \
+                 surface RMS {:.3e} mm, {} L-BFGS iterations, {}",
+                d.ratio,
+                100.0 * (d.ratio / optimum - 1.0),
+                1e3 * d.surface_rms_m,
+                d.iterations,
+                ringmesh::report::json_name(&d.termination)
+            );
+        }
+        group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
+            b.iter(|| Gradient::default().solve(p))
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     solvers,
     bisection_tolerance,
     lp_nodes,
     lp_independent,
-    gradient_nodes
+    gradient_nodes,
+    gradient_independent
 );
 criterion_main!(benches);

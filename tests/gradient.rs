@@ -257,7 +257,7 @@ fn free_layout_slides_to_an_equal_tension_net() {
 /// With the geometry held (a weight of 1e-8: the surface term dominates),
 /// the design is the fixed-geometry optimum: within 1 % of `lp`'s ratio
 /// with a surface RMS of at most 1e-3 mm, on small-hex and on paper-26m
-/// with 3 rings (issue 17).
+/// with 3 rings (issue 17), started away from it.
 #[test]
 fn geometry_held_reaches_the_lp_optimum() {
     let mut paper = common::scene("paper-26m");
@@ -266,8 +266,11 @@ fn geometry_held_reaches_the_lp_optimum() {
     for scene in [common::scene("small-hex"), paper] {
         let problem = common::front_problem(&scene);
         let lp = Lp.solve(&problem).unwrap();
+        // From the projected uniform-tension guess, not from `lp`'s
+        // optimum: the descent itself must get there.
         let design = Gradient {
             weight: 1e-8,
+            optimum_start: false,
             ..Gradient::default()
         }
         .solve(&problem)

@@ -97,7 +97,7 @@ use lbfgs::{minimise, Variables};
 use map::Map;
 use objective::Objective;
 use preconditioner::Preconditioner;
-use start::projected_start;
+use start::{optimum_start, projected_start};
 
 /// Growth of the sharpness per restart.
 const SHARPNESS_GROWTH: f64 = 3.0;
@@ -139,6 +139,9 @@ pub struct Gradient {
     /// Start from the uniform-tension guess projected onto equilibrium at the
     /// design geometry; `false` starts from the network's `q`.
     pub project_start: bool,
+    /// Start from the fixed-geometry optimum (`lp`'s design) where `lp`
+    /// applies (one set, no loads), before any other start.
+    pub optimum_start: bool,
 }
 
 impl Default for Gradient {
@@ -157,6 +160,7 @@ impl Default for Gradient {
             cost_tolerance: 1e-12,
             precondition: true,
             project_start: true,
+            optimum_start: true,
         }
     }
 }
@@ -256,8 +260,14 @@ impl Gradient {
         let mut warnings = Vec::new();
         let m = problem.network().n_edges();
         let warm = start.filter(|q| q.len() == m && q.iter().all(|v| v.is_finite() && *v > 0.0));
-        let mut q = match warm {
-            Some(q) => q.to_vec(),
+        let optimum = if warm.is_none() && self.optimum_start {
+            optimum_start(problem)
+        } else {
+            None
+        };
+        let near_optimum = warm.is_some() || optimum.is_some();
+        let mut q = match warm.map(<[f64]>::to_vec).or(optimum) {
+            Some(q) => q,
             None if self.project_start => {
                 projected_start(problem, &objective.map).unwrap_or_else(|e| {
                     warnings.push(format!(
@@ -283,7 +293,7 @@ impl Gradient {
         // A warm start begins at the final sharpness: its point is already
         // near the sharp problem's minimiser, and a smooth stage would pull
         // it away first.
-        let first_sharpness = if warm.is_some() {
+        let first_sharpness = if near_optimum {
             self.sharpness
         } else {
             self.initial_sharpness.min(self.sharpness)
