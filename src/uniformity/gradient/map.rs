@@ -3,7 +3,9 @@
 
 use super::super::UniformityProblem;
 
-/// Lower asymptote of the map, as a fraction of `[q]`.
+/// Lower asymptote of the map, as a fraction of the problem's typical force
+/// density (or of `[q]`, if lower): `D` stays numerically positive definite,
+/// and no design's `q` is cut off however far the bound is lifted.
 const FLOOR_FRACTION: f64 = 1e-9;
 
 /// The smooth bijection `θ ↦ q = q_0 + ([q] − q_0) σ(θ)` onto `(q_0, [q])`, or
@@ -20,7 +22,12 @@ impl Map {
     pub(super) fn new(problem: &UniformityProblem) -> Self {
         let q_max = problem.max_force_density_n_per_m;
         if q_max.is_finite() {
-            let floor = FLOOR_FRACTION * q_max;
+            let set = &problem.sets()[0];
+            let lengths = problem.lengths_m();
+            let mean_length =
+                set.edges.iter().map(|&k| lengths[k]).sum::<f64>() / set.edges.len() as f64;
+            let typical = set.mean_tension_n / mean_length;
+            let floor = FLOOR_FRACTION * q_max.min(typical);
             Map::Bounded {
                 floor,
                 span: q_max - floor,
