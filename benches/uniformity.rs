@@ -49,6 +49,18 @@ fn problem(name: &str, rings: Option<usize>) -> UniformityProblem {
     scene_problem(&scene).expect("valid scene").1
 }
 
+/// `sizes` and the comma-separated sizes of the environment variable `var`.
+fn with_extra(mut sizes: Vec<usize>, var: &str) -> Vec<usize> {
+    if let Ok(extra) = std::env::var(var) {
+        sizes.extend(
+            extra
+                .split(',')
+                .filter_map(|r| r.trim().parse::<usize>().ok()),
+        );
+    }
+    sizes
+}
+
 /// Largest problem `solver/bisection` is run on (the 6-ring scene).
 const BISECTION_MAX_CABLES: usize = 5_000;
 
@@ -101,14 +113,7 @@ fn bisection_tolerance(c: &mut Criterion) {
 }
 
 fn lp_nodes(c: &mut Criterion) {
-    let mut rings = vec![4, 18, 32];
-    if let Ok(extra) = std::env::var("RINGMESH_BENCH_RINGS") {
-        rings.extend(
-            extra
-                .split(',')
-                .filter_map(|r| r.trim().parse::<usize>().ok()),
-        );
-    }
+    let rings = with_extra(vec![4, 18, 32], "RINGMESH_BENCH_RINGS");
     let mut group = c.benchmark_group("lp_nodes");
     group
         .sample_size(10)
@@ -125,14 +130,7 @@ fn lp_nodes(c: &mut Criterion) {
 }
 
 fn lp_independent(c: &mut Criterion) {
-    let mut sizes = vec![1_000, 10_000];
-    if let Ok(extra) = std::env::var("RINGMESH_BENCH_FREE") {
-        sizes.extend(
-            extra
-                .split(',')
-                .filter_map(|r| r.trim().parse::<usize>().ok()),
-        );
-    }
+    let sizes = with_extra(vec![1_000, 10_000], "RINGMESH_BENCH_FREE");
     let mut group = c.benchmark_group("lp_independent");
     group
         .sample_size(10)
@@ -170,14 +168,7 @@ fn gradient_nodes(c: &mut Criterion) {
 /// 428 and 4 208 nodes by default (issue 17's ~430-node net and the next
 /// decade); `RINGMESH_BENCH_GRADIENT_RINGS=41,130` adds ≈ 10⁴ and 10⁵.
 fn gradient_independent(c: &mut Criterion) {
-    let mut rings = vec![8, 26];
-    if let Ok(extra) = std::env::var("RINGMESH_BENCH_GRADIENT_RINGS") {
-        rings.extend(
-            extra
-                .split(',')
-                .filter_map(|r| r.trim().parse::<usize>().ok()),
-        );
-    }
+    let rings = with_extra(vec![8, 26], "RINGMESH_BENCH_GRADIENT_RINGS");
     let mut group = c.benchmark_group("gradient_independent");
     group.sample_size(10);
     for r in rings {

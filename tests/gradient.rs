@@ -11,7 +11,7 @@ use ringmesh::design::{LoopSettings, LoopTermination, SceneNets};
 use ringmesh::geometry::build_mesh;
 use ringmesh::scene::TrussModel;
 use ringmesh::uniformity::{
-    design_front, Gradient, Lp, SolverKind, SurfaceTarget, Termination, UniformityProblem,
+    design_front, Design, Gradient, Lp, SolverKind, SurfaceTarget, Termination, UniformityProblem,
     UniformitySet, UniformitySolver,
 };
 use ringmesh::{CableGroup, Scene};
@@ -168,29 +168,34 @@ fn gradient_descends_to_a_stationary_point() {
     assert!(history.objective.last().unwrap() < &history.objective[0]);
 }
 
-/// Within 5 % of the LP optimum, a surface RMS of at most 1 µm, and `q` in bounds.
-fn assert_near_lp_optimum(name: &str) {
-    let scene = common::scene(name);
-    let problem = common::front_problem(&scene);
-    let lp = Lp.solve(&problem).unwrap();
-    let design = Gradient::default().solve(&problem).unwrap();
+/// `design` converged, its ratio within `factor` of the LP optimum
+/// `lp_ratio`, and its surface RMS at most 1 µm.
+fn assert_converged_near(name: &str, design: &Design, lp_ratio: f64, factor: f64) {
     assert_eq!(
         design.termination,
         Termination::Converged,
-        "{:?}",
+        "{name}: {:?}",
         design.warnings
     );
     assert!(
-        design.ratio <= 1.05 * lp.ratio,
-        "{name}: ratio {} vs LP {}",
-        design.ratio,
-        lp.ratio
+        design.ratio <= factor * lp_ratio,
+        "{name}: ratio {} vs LP {lp_ratio}",
+        design.ratio
     );
     assert!(
         design.surface_rms_m <= 1e-6,
         "{name}: surface RMS {:e} m",
         design.surface_rms_m
     );
+}
+
+/// Within 5 % of the LP optimum, a surface RMS of at most 1 µm, and `q` in bounds.
+fn assert_near_lp_optimum(name: &str) {
+    let scene = common::scene(name);
+    let problem = common::front_problem(&scene);
+    let lp = Lp.solve(&problem).unwrap();
+    let design = Gradient::default().solve(&problem).unwrap();
+    assert_converged_near(name, &design, lp.ratio, 1.05);
     let q_max = scene.cables.max_force_density_n_per_m;
     assert!(design.q.iter().all(|&q| q > 0.0 && q <= q_max));
     let mean = &design.sets[0].mean_tension_n;
@@ -275,24 +280,7 @@ fn geometry_held_reaches_the_lp_optimum() {
         }
         .solve(&problem)
         .unwrap();
-        let name = &scene.name;
-        assert_eq!(
-            design.termination,
-            Termination::Converged,
-            "{name}: {:?}",
-            design.warnings
-        );
-        assert!(
-            design.ratio <= 1.01 * lp.ratio,
-            "{name}: ratio {} vs lp {}",
-            design.ratio,
-            lp.ratio
-        );
-        assert!(
-            design.surface_rms_m <= 1e-6,
-            "{name}: RMS {:e} m",
-            design.surface_rms_m
-        );
+        assert_converged_near(&scene.name, &design, lp.ratio, 1.01);
     }
 }
 

@@ -112,13 +112,7 @@ pub const STUDY_COLUMNS: &str = "knob,value,tolerance_m,elements_per_rod,rings,t
 /// One line of `accuracy-vs-time.csv` (without its newline); missing numbers
 /// are empty.
 pub fn study_row(r: &StudyRow) -> String {
-    let g = |v: f64| {
-        if v.is_finite() {
-            readable(v, 7)
-        } else {
-            String::new()
-        }
-    };
+    let g = |v: f64| finite(v, 7);
     let s = &r.settings;
     format!(
         "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
@@ -133,8 +127,8 @@ pub fn study_row(r: &StudyRow) -> String {
         r.outer_iterations.map_or(String::new(), |n| n.to_string()),
         r.termination.map_or(String::new(), |t| json_name(&t)),
         g(r.boundary_residual_m),
-        finite(r.ratio),
-        finite(r.built_ratio),
+        finite(r.ratio, 11),
+        finite(r.built_ratio, 11),
         g(r.ratio_error),
         g(r.rms_mm),
         g(r.max_deviation_mm),
@@ -364,8 +358,8 @@ pub fn aperture_csv(results: &[ApertureResult]) -> String {
                 readable(r.hinge_motion_mm, 7),
                 value_name(&m.model),
                 m.outer_iterations,
-                finite(m.ratio),
-                finite(m.built_ratio),
+                finite(m.ratio, 11),
+                finite(m.built_ratio, 11),
                 readable(m.rms_mm, 7),
                 readable(m.max_deviation_mm, 7),
                 readable(m.tension_change_pct, 7),
@@ -380,10 +374,10 @@ pub fn aperture_csv(results: &[ApertureResult]) -> String {
     s
 }
 
-/// A ratio (11 significant digits), or nothing when it is not finite.
-fn finite(v: f64) -> String {
+/// `v` with `digits` significant digits, or nothing when it is not finite.
+fn finite(v: f64, digits: usize) -> String {
     if v.is_finite() {
-        readable(v, 11)
+        readable(v, digits)
     } else {
         String::new()
     }

@@ -294,9 +294,22 @@ pub(crate) fn infeasible_design(
     solver: &str,
     iterations: usize,
     start: Instant,
-    mut warnings: Vec<String>,
+    warnings: Vec<String>,
 ) -> Result<Design, UniformityError> {
-    let slack = match slack_nodes(problem) {
+    let slack = slack_nodes(problem);
+    infeasible_design_with(problem, solver, iterations, start, warnings, slack)
+}
+
+/// [`infeasible_design`] with the slack analysis already made.
+pub(crate) fn infeasible_design_with(
+    problem: &UniformityProblem,
+    solver: &str,
+    iterations: usize,
+    start: Instant,
+    mut warnings: Vec<String>,
+    slack: Result<SlackNodes, UniformityError>,
+) -> Result<Design, UniformityError> {
+    let slack = match slack {
         Ok(slack) if slack.count > 0 => {
             warnings.push(slack.to_string());
             Some(slack)

@@ -120,15 +120,11 @@ pub fn design_front_points(
         .par_iter()
         .flat_map_iter(|chain| {
             let mut previous: Option<Design> = None;
-            let points: Vec<FrontPoint> = chain
-                .iter()
-                .map(|&(solver, knob)| {
-                    let point = front_point(problem, solver, knob, &mut previous);
-                    on_point(&point);
-                    point
-                })
-                .collect();
-            points
+            chain.iter().map(move |&(solver, knob)| {
+                let point = front_point(problem, solver, knob, &mut previous);
+                on_point(&point);
+                point
+            })
         })
         .collect()
 }

@@ -8,8 +8,9 @@
 //!
 //! $$q_k = q_0 + ([q] − q_0)\,σ(θ_k), \qquad σ(θ) = 1/(1 + e^{−θ}),$$
 //!
-//! so `q_0 < q < [q]` for every `θ` (`q_0 = 10⁻⁹ [q]` keeps `D` numerically
-//! positive definite); for `q ≪ [q]`, `θ ≈ ln(q/[q])`. The objective is
+//! so `q_0 < q < [q]` for every `θ` (`q_0` = 10⁻⁹ of the problem's typical
+//! force density, or of `[q]` if lower, keeps `D` numerically positive
+//! definite); for `q ≪ [q]`, `θ ≈ ln(q/[q])`. The objective is
 //!
 //! $$J = \frac{1}{n_s L^2}\Big(\sum_{i\in\text{surf}} e_i^2 + λ_{\text{lay}}
 //!   \sum_i d_i^2\Big) + w \sum_g R_g(T) + κ \ln^2\frac{\bar T_0}{t_0} + ν B(q)$$
@@ -72,17 +73,24 @@
 //! re-linearises. The sharpness starts at [`Gradient::initial_sharpness`] and
 //! grows ×3 per run up to [`Gradient::sharpness`] (a smooth surrogate first, the
 //! sharp one at the end). At the final sharpness the solve has converged when
-//! `‖dJ/dθ‖` (checked at every accepted iterate) falls below
-//! [`Gradient::gradient_tolerance`] times its value at the network's `q`, or when
-//! a whole run lowers `J` by no more than [`Gradient::cost_tolerance`]`·|J|`.
-//! Terminations: `Converged` (either test), `MaxIterations`, `Stalled` (a line
-//! search that failed in the last run), `NumericalError` (a forward solve
-//! failed: the best point so far is returned).
+//! the stationarity `‖dJ/dθ‖∞ / J` (checked at every accepted iterate) falls
+//! to [`Gradient::gradient_tolerance`], or when a whole run lowers `J` by no
+//! more than [`Gradient::cost_tolerance`]`·|J|`. Terminations: `Converged`
+//! (either test), `MaxIterations`, `Stalled` (a line search that failed in
+//! the last run, or a design below the tension floor that positive force
+//! densities could avoid), `Infeasible` (a shape that needs slack cables: the
+//! slack analysis names the nodes), `NumericalError` (a forward solve failed:
+//! the best point so far is returned).
 //!
-//! The start is the uniform-tension guess (`T = t_g` on the set cables at
-//! design lengths, the network's `q` elsewhere) moved onto equilibrium at the
-//! design geometry by damped Gauss–Newton steps in `θ` (a handful of sparse
-//! solves), then scaled to the target level.
+//! The start, in order: a neighbouring problem's design
+//! ([`super::UniformitySolver::solve_from`]: the previous outer iteration's,
+//! the neighbouring weight's); the fixed-geometry optimum (`lp`'s design)
+//! where `lp` applies ([`Gradient::optimum_start`]); or the uniform-tension
+//! guess (`T = t_g` on the set cables at design lengths, the network's `q`
+//! elsewhere) moved onto equilibrium at the design geometry by damped
+//! Gauss–Newton steps in `θ` (a handful of sparse solves), then scaled to the
+//! target level. The first two begin at the final sharpness, the last at
+//! [`Gradient::initial_sharpness`].
 
 mod lbfgs;
 mod map;
@@ -248,7 +256,7 @@ impl Gradient {
 
     /// [`Gradient::solve_with_history`] from the force densities `start`
     /// (a neighbouring problem's design: the previous outer iteration's, the
-    /// neighbouring weight's), or from the projected uniform-tension guess.
+    /// neighbouring weight's), or from the starts of the module documentation.
     pub fn solve_history_from(
         &self,
         problem: &UniformityProblem,
@@ -279,10 +287,14 @@ impl Gradient {
             None => problem.network().q.clone(),
         };
         // Into the map's range, as the solver's iterates are.
-        q = self.q_of_theta(problem, &self.theta_of_q(problem, &q));
+        let map = objective.map;
+        q = q.iter().map(|&v| map.q(map.theta(v))).collect();
 
         let (j, g) = objective.evaluate_q(&q)?;
         let stationarity = objective.stationarity(&q, j, &g);
+        // `J` at the current `q` and the sharpness it was evaluated at: a
+        // run at that sharpness starts from it instead of evaluating again.
+        let mut current = (self.sharpness, j);
         let mut history = History {
             objective: vec![j],
             gradient_norm: vec![objective.theta_gradient_norm(&q, &g)],
@@ -290,9 +302,9 @@ impl Gradient {
             evaluations: 1,
             runs: 0,
         };
-        // A warm start begins at the final sharpness: its point is already
-        // near the sharp problem's minimiser, and a smooth stage would pull
-        // it away first.
+        // A start near the optimum begins at the final sharpness: its point
+        // is already near the sharp problem's minimiser, and a smooth stage
+        // would pull it away first.
         let first_sharpness = if near_optimum {
             self.sharpness
         } else {
@@ -322,8 +334,12 @@ impl Gradient {
             let sharpness =
                 (first_sharpness * SHARPNESS_GROWTH.powi(history.runs as i32)).min(self.sharpness);
             let objective = objective.with_sharpness(sharpness);
-            let before = objective.evaluate_q(&q)?.0;
-            history.evaluations += 1;
+            let before = if current.0 == sharpness {
+                current.1
+            } else {
+                history.evaluations += 1;
+                objective.evaluate_q(&q)?.0
+            };
             let variables = Variables::new(&objective, preconditioner.as_ref(), &q);
             let run = minimise(
                 &variables,
@@ -340,6 +356,7 @@ impl Gradient {
             let (after, g) = objective.evaluate_q(&q)?;
             history.stationarity = objective.stationarity(&q, after, &g);
             history.evaluations += 1;
+            current = (sharpness, after);
             if matches!(termination, Termination::NumericalError) {
                 break;
             }
@@ -387,12 +404,13 @@ impl Gradient {
                 "cable {k} holds {:.3e} N, below the floor {floor:.3e} N: the shape needs slack cables",
                 design.tensions_n[k]
             ));
-            return super::conic::infeasible_design(
+            return super::conic::infeasible_design_with(
                 problem,
                 self.name(),
                 design.iterations,
                 clock,
                 warnings,
+                Ok(slack),
             );
         }
         design.warnings.push(format!(
