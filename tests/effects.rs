@@ -240,3 +240,33 @@ fn truss_self_weight_totals_its_mass() {
         "{total} N vs {expected} N"
     );
 }
+
+/// Under gravity the shape is not invariant under `q → c q`: `bisection`
+/// holds the front net's mean tension exactly, least squares cannot scale
+/// its design onto it and says so (issue 19).
+#[test]
+fn under_gravity_a_solver_that_cannot_hold_the_level_says_so() {
+    let scene = scene_under(Some([0.0, 0.3, -1.0]));
+    let mean_of = |net: &Design| {
+        net.groups
+            .iter()
+            .find(|g| g.name == "front")
+            .unwrap()
+            .mean_tension_n
+    };
+    let target = scene.front_net.mean_tension_n;
+    for solver in [SolverKind::Bisection, SolverKind::LeastSquares] {
+        let settings = ringmesh::design::DesignSettings {
+            solver: Some(solver),
+            ..Default::default()
+        };
+        let run = ringmesh::design::run(&scene, &settings, &mut |_, _| {}).unwrap();
+        let net = &run.report.net;
+        let miss = (mean_of(net) / target - 1.0).abs();
+        let said = net.warnings.iter().any(|w| w.contains("pretension level"));
+        match solver {
+            SolverKind::Bisection => assert!(miss <= 1e-9 && !said, "{miss:e}"),
+            _ => assert!(miss > 1e-3 && said, "{miss:e}: {:?}", net.warnings),
+        }
+    }
+}

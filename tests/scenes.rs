@@ -114,7 +114,7 @@ fn paper_scene_carries_table_3_but_the_tubes() {
             scene.truss.tube_outer_diameter_m,
             scene.truss.tube_inner_diameter_m
         ),
-        (0.120, 0.112)
+        (0.130, 0.122)
     );
     assert_eq!(scene.truss.youngs_modulus_pa, 160e9);
     assert_eq!(

@@ -20,9 +20,16 @@
 //!    the plan, `min Σ ((q − q₀)/q₀)²` s.t. `A_plan q = 0`, `q₀ = α q_front`;
 //!    then the tie forces, as vertical loads, give the rear nodes' heights by
 //!    one forward force density solve, and the ties' force densities follow
-//!    from their new lengths. `α` is fitted to the vertical balance of the
-//!    nominal rear net (`α = F_rear/F` for two paraboloids), so the rear shape
-//!    stays near its nominal paraboloid.
+//!    from their new lengths. The level `α` is the one at which the rear
+//!    net's interior cables carry the scene's `rear_net.mean_tension_n`
+//!    (a few secant steps from the vertical balance of the nominal rear net,
+//!    `α = F_rear/F` for two paraboloids): the level sets the rear net's
+//!    depth, which nothing else asks for.
+//!
+//! Both nets therefore carry the mean tensions the scene asks for: the
+//! front net's by the solver, or by scaling its design where the solver does
+//! not hold the level and no load breaks the shape's invariance under
+//! `q → c q` ([`Design::at_level`]).
 //!
 //! Before both stages the plan grid is rebuilt by the mesh's own construction
 //! on the deformed top hinges, so the free nodes move with the boundary (the
@@ -60,6 +67,28 @@ const WEIGHT_TOLERANCE: f64 = 1e-13;
 
 /// Most passes of the stages under gravity.
 const MAX_WEIGHT_PASSES: usize = 8;
+
+/// Plan offset of a tie's anchor from its node below which the tie hangs
+/// plumb, m.
+const PLUMB_TOLERANCE_M: f64 = 1e-13;
+
+/// Most forward solves that plumb the ties.
+const PLUMB_PASSES: usize = 6;
+
+/// Relative error, in `ln`, at which the rear net holds its mean tension.
+const REAR_LEVEL_TOLERANCE: f64 = 1e-13;
+
+/// Most secant steps on the rear level.
+const REAR_LEVEL_STEPS: usize = 20;
+
+/// What stage 2 finds: the rear force densities and node positions (the rear
+/// net's numbering), the level `α`, and a warning if the level missed.
+struct RearStage {
+    q: Vec<f64>,
+    nodes_xyz_m: Vec<[f64; 3]>,
+    alpha: f64,
+    warning: Option<String>,
+}
 
 /// Largest component difference of two load lists (`b` may be empty: zero).
 fn max_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
@@ -360,37 +389,37 @@ impl TiedNets {
             selected.warnings.splice(0..0, front_design.warnings);
             front_design = selected;
         }
+        let (front, front_design) = self.plumb_ties(front, front_design)?;
+        let mut front_design = front_design.at_level(&front)?;
         let q_front = &front_design.q;
+        let balanced = &front_design.nodes_xyz_m;
+        for &(_, i, r) in &self.ties {
+            whole[r][..2].copy_from_slice(&balanced[i][..2]);
+        }
 
         // Stage 2: rear force densities balancing the plan, then heights.
-        let alpha = self.alpha(q_front);
-        let rear_plan: Vec<[f64; 3]> = whole[n_front..].iter().map(|p| [p[0], p[1], 0.0]).collect();
-        let mirror: Vec<f64> = q_front[..n].iter().map(|q| alpha * q).collect();
-        let mut loads = weights.as_ref().map_or_else(
-            || vec![[0.0; 3]; rear_plan.len()],
-            |w| w[n_front..].to_vec(),
-        );
-        let q_rear = self.balance_plan(&rear_plan, &mirror, &loads)?;
-        for (t, &(_, _, r)) in self.ties.iter().enumerate() {
-            loads[r - n_front][2] += front_design.tensions_n[n + t];
+        let rear = self.rear_stage(q_front, &front_design.tensions_n[n..], whole, weights)?;
+        if let Some(warning) = rear.warning {
+            front_design.warnings.push(warning);
         }
-        let rear_nodes = whole[n_front..].to_vec();
-        let rear = self.rear.solve(&q_rear, &rear_nodes, Some(&loads))?;
         for &i in self.rear.free_nodes() {
             whole[n_front + i] = rear.nodes_xyz_m[i];
         }
+        let (q_rear, alpha) = (rear.q, rear.alpha);
+        let q_front = &front_design.q;
         let mut q = vec![0.0; network.n_edges()];
         q[..n].copy_from_slice(&q_front[..n]);
         q[n..2 * n].copy_from_slice(&q_rear);
         for (t, &(k, i, r)) in self.ties.iter().enumerate() {
-            let length = whole[i][2] - whole[r][2];
+            let top = front_design.nodes_xyz_m[i][2];
+            let length = top - whole[r][2];
             if length.is_nan() || length <= 0.0 {
                 return Err(UniformityError::invalid(
                     format!("tie {k}"),
                     format!(
-                        "the rear node {r} rises to {:.4} m, above front node {i} at {:.4} m — \
+                        "the rear node {r} rises to {:.4} m, above front node {i} at {top:.4} m — \
                          the rear net is too slack for this boundary",
-                        whole[r][2], whole[i][2]
+                        whole[r][2]
                     ),
                 ));
             }
@@ -398,6 +427,124 @@ impl TiedNets {
         }
 
         Ok((front_design, q, alpha))
+    }
+
+    /// The front stage's `design` judged again with every tie anchored
+    /// straight below the node it holds, where the design balances that node:
+    /// the design geometry for the exact solvers (no change), the free
+    /// geometry for `gradient`, whose slanted ties would otherwise lose their
+    /// plan pull in the whole network (measured on `small-hex`: the front
+    /// net's mean tension 1.8e-8 off its target). The rear nodes go below
+    /// the same points, so the whole network's forward solve finds both
+    /// stages' tensions again. A few forward solves at most: each moves the
+    /// nodes by the plan pull of the last offset.
+    fn plumb_ties(
+        &self,
+        mut front: UniformityProblem,
+        mut design: Design,
+    ) -> Result<(UniformityProblem, Design), UniformityError> {
+        let n_front = self.n_front;
+        let mut last = f64::INFINITY;
+        for _ in 0..PLUMB_PASSES {
+            let mut nodes = front.network().nodes.clone();
+            let mut offset: f64 = 0.0;
+            for (t, &(_, i, _)) in self.ties.iter().enumerate() {
+                let (top, anchor) = (design.nodes_xyz_m[i], &mut nodes[n_front + t]);
+                offset = offset.max((top[0] - anchor[0]).hypot(top[1] - anchor[1]));
+                anchor[..2].copy_from_slice(&top[..2]);
+            }
+            if offset <= PLUMB_TOLERANCE_M || offset >= last {
+                break;
+            }
+            last = offset;
+            front = front.with_positions(nodes)?;
+            let q = design.q.clone();
+            design = design.judged_again(&front, q)?;
+        }
+        Ok((front, design))
+    }
+
+    /// Stage 2 for the front design `q_front` whose ties pull with
+    /// `tie_tensions`: the rear force densities closest to the mirror
+    /// `α q_front` that balance the plan ([`TiedNets::balance_plan`]), then
+    /// the rear heights under the ties' pull, at the level `α` at which the
+    /// rear net's interior cables carry the scene's mean tension
+    /// ([`ReflectorMesh::rear_mean_tension_n`]). The level sets the rear
+    /// net's depth (its shape is free): secant steps on `ln α` from the
+    /// vertical-balance fit [`TiedNets::alpha`], which the mean tension
+    /// follows nearly in proportion (measured: 5 steps to 1e-13). A level
+    /// that cannot be reached keeps the best one and says so.
+    fn rear_stage(
+        &self,
+        q_front: &[f64],
+        tie_tensions: &[f64],
+        whole: &[[f64; 3]],
+        weights: Option<&[[f64; 3]]>,
+    ) -> Result<RearStage, UniformityError> {
+        let (n_front, n) = (self.n_front, self.n_front_cables);
+        let rear_plan: Vec<[f64; 3]> = whole[n_front..].iter().map(|p| [p[0], p[1], 0.0]).collect();
+        let plan_loads = weights.map_or_else(
+            || vec![[0.0; 3]; rear_plan.len()],
+            |w| w[n_front..].to_vec(),
+        );
+        let mut loads = plan_loads.clone();
+        for (&(_, _, r), t) in self.ties.iter().zip(tie_tensions) {
+            loads[r - n_front][2] += t;
+        }
+        let rear_nodes = whole[n_front..].to_vec();
+        let interior: Vec<usize> = (0..n)
+            .filter(|&k| self.mesh.groups[k + n] == CableGroup::Rear)
+            .collect();
+        let target = self.mesh.rear_mean_tension_n;
+        let at = |alpha: f64| -> Result<(RearStage, f64), UniformityError> {
+            let mirror: Vec<f64> = q_front[..n].iter().map(|q| alpha * q).collect();
+            let q = self.balance_plan(&rear_plan, &mirror, &plan_loads)?;
+            let rear = self.rear.solve(&q, &rear_nodes, Some(&loads))?;
+            let mean = interior
+                .iter()
+                .map(|&k| rear.edges_forces_n[k])
+                .sum::<f64>()
+                / interior.len() as f64;
+            let stage = RearStage {
+                q,
+                nodes_xyz_m: rear.nodes_xyz_m,
+                alpha,
+                warning: None,
+            };
+            Ok((stage, (mean / target).ln()))
+        };
+        let mut a = self.alpha(q_front).ln();
+        let (mut best, mut f) = at(a.exp())?;
+        if interior.is_empty() {
+            return Ok(best);
+        }
+        let mut previous: Option<(f64, f64)> = None;
+        for _ in 0..REAR_LEVEL_STEPS {
+            if f.abs() <= REAR_LEVEL_TOLERANCE {
+                return Ok(best);
+            }
+            // The mean tension is nearly proportional to α: slope 1 first.
+            let slope = match previous {
+                Some((a0, f0)) if f != f0 => (f - f0) / (a - a0),
+                _ => 1.0,
+            };
+            previous = Some((a, f));
+            a -= f / slope;
+            let (stage, next) = at(a.exp())?;
+            if !next.is_finite() {
+                break;
+            }
+            (best, f) = (stage, next);
+        }
+        if f.abs() > REAR_LEVEL_TOLERANCE {
+            best.warning = Some(format!(
+                "the rear net's mean tension is {} N, not the scene's {} N \
+                 (rear_net.mean_tension_n): its level did not converge in {REAR_LEVEL_STEPS} steps",
+                target * f.exp(),
+                target,
+            ));
+        }
+        Ok(best)
     }
 
     /// The rear level `α` that best balances the nominal rear net vertically

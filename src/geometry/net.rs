@@ -54,6 +54,9 @@ pub struct ReflectorMesh {
     pub front_triangles: Vec<[usize; 3]>,
     /// Inward sag of the free boundary, as a fraction of the bay chord.
     pub boundary_sag_ratio: f64,
+    /// The rear net's target mean tension over its interior cables, N
+    /// (`rear_net.mean_tension_n`): the design holds it.
+    pub rear_mean_tension_n: f64,
 }
 
 impl ReflectorMesh {
@@ -321,6 +324,7 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
         rings,
         front_triangles: grid.triangles,
         boundary_sag_ratio: scene.front_net.boundary_sag_ratio,
+        rear_mean_tension_n: scene.rear_net.mean_tension_n,
     })
 }
 

@@ -86,6 +86,17 @@ impl StaticSolver {
         lambda: f64,
         settings: &StaticSettings,
     ) -> (f64, bool) {
+        self.converged_within(ev, lambda, settings, 1.0)
+    }
+
+    /// [`StaticSolver::converged`] with the tolerances × `factor`.
+    pub(super) fn converged_within(
+        &self,
+        ev: &Evaluation,
+        lambda: f64,
+        settings: &StaticSettings,
+        factor: f64,
+    ) -> (f64, bool) {
         let n = self.system.n_free;
         let force = norm_inf(&ev.residual[..n]);
         let gap = norm_inf(&ev.residual[n..]) / self.system.scale;
@@ -98,10 +109,10 @@ impl StaticSolver {
         let force_scale = (self.load_scale() * lambda.abs())
             .max(reaction_scale)
             .max(ev.prestress_scale);
-        let tol = (settings.tolerance * force_scale).max(roundoff);
+        let tol = factor * (settings.tolerance * force_scale).max(roundoff);
         (
             force,
-            force <= tol && gap <= settings.tolerance * self.length_scale,
+            force <= tol && gap <= factor * settings.tolerance * self.length_scale,
         )
     }
 

@@ -11,6 +11,10 @@ use serde::Serialize;
 
 use super::{UniformityError, UniformityProblem};
 
+/// Relative miss of a set's mean tension within which a design holds its
+/// pretension level ([`Design::at_level`]).
+const LEVEL_TOLERANCE: f64 = 1e-9;
+
 /// How a solver stopped. Not converging is a status, not an error: a caller can
 /// never mistake it for a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -186,6 +190,64 @@ impl Design {
         } else {
             Ok(self)
         }
+    }
+
+    /// The design at its first set's target mean tension (DESIGN §4: the
+    /// pretension level). `lp` and `bisection` hold it already; least squares
+    /// does not, and `gradient` only by a penalty. Without nodal loads the
+    /// shape is invariant under `q → c q`, so scaling by `c = T̄₀/mean T`
+    /// holds the level exactly for any solver (one forward solve). Under
+    /// loads scaling would break equilibrium: a miss beyond
+    /// `LEVEL_TOLERANCE` (1e-9, relative) is kept and said in a warning.
+    ///
+    /// # Errors
+    /// The forward solve of the scaled `q` failed.
+    pub fn at_level(mut self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
+        let (Some(set), Some(spread)) = (problem.sets().first(), self.sets.first()) else {
+            return Ok(self);
+        };
+        let scale = set.mean_tension_n / spread.mean_tension_n;
+        if !scale.is_finite() || (scale - 1.0).abs() <= LEVEL_TOLERANCE {
+            return Ok(self);
+        }
+        if problem.has_loads() {
+            self.warnings.push(format!(
+                "{} holds the pretension level only to {:.2e} (relative) under nodal loads: `{}` \
+                 has a mean tension of {} N for its target {} N (lp and bisection hold it exactly)",
+                self.solver,
+                1.0 / scale - 1.0,
+                set.name,
+                spread.mean_tension_n,
+                set.mean_tension_n,
+            ));
+            return Ok(self);
+        }
+        let q = self.q.iter().map(|q| scale * q).collect();
+        self.judged_again(problem, q)
+    }
+
+    /// The same solver's outcome (termination, iterations, time, warnings)
+    /// judged afresh with `q` on `problem`.
+    ///
+    /// # Errors
+    /// The forward solve failed.
+    pub fn judged_again(
+        self,
+        problem: &UniformityProblem,
+        q: Vec<f64>,
+    ) -> Result<Design, UniformityError> {
+        let mut design = Design::evaluate(
+            problem,
+            &self.solver,
+            q,
+            self.termination,
+            self.iterations,
+            Duration::from_secs_f64(self.time_s),
+            self.warnings,
+        )?;
+        design.route = self.route;
+        design.slack_nodes = self.slack_nodes;
+        Ok(design)
     }
 
     /// Judges `q` on `problem`: forward solve, tensions, spreads, residual, surface
