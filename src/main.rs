@@ -385,6 +385,8 @@ fn bar() -> Bar {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // SIGINT, SIGTERM, SIGHUP: no staging folder or temporary file is left.
+    let _ = ctrlc::set_handler(|| ringmesh::report::abandon_all_and_exit(130));
     let result = match &cli.command {
         Command::Mesh { scene, output } => ringmesh::run::mesh(scene, output.as_deref()).map(|m| {
             say!("scene: {}", m.scene);

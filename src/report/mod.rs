@@ -1,8 +1,10 @@
 //! Files a run writes: JSON, CSV, VTK, plots. Every file is written to a temporary file in
-//! the target folder and renamed into place, so a reader never sees half a file
-//! and an interrupted run leaves earlier results intact.
+//! its folder and renamed into place, so a reader never sees half a file; a
+//! command's files go into the target folder together or not at all
+//! ([`OutputSet`]).
 
 mod csv;
+mod output_set;
 mod plot;
 mod vtk;
 
@@ -15,6 +17,7 @@ pub use csv::{
     aperture_csv, cables_csv, convergence_csv, front_csv, front_row, json_name, parse_front_row,
     parse_study_row, sizing_csv, study_csv, study_row, FrontRow, FRONT_COLUMNS, STUDY_COLUMNS,
 };
+pub use output_set::{abandon_all_and_exit, check_manifest, FileRecord, OutputSet, RunRecord};
 pub use plot::{
     aperture_plot, convergence_plot, front_plot, study_plot, surface_plot, NodePanel, SurfaceFigure,
 };
@@ -24,7 +27,7 @@ pub use vtk::{assembly_vtu, network_vtu};
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
     /// The file system refused.
-    #[error("writing {path}: {source}")]
+    #[error("writing {}: {source}", output_set::shown(path).display())]
     Io {
         /// The file.
         path: PathBuf,
@@ -32,15 +35,41 @@ pub enum ReportError {
         source: std::io::Error,
     },
     /// A plot could not be drawn.
-    #[error("drawing {path}: {source}")]
+    #[error("drawing {}: {source}", output_set::shown(path).display())]
     Plot {
         /// The file.
         path: PathBuf,
         /// The backend's error.
         source: DrawError,
     },
+    /// Another run holds the output folder ([`OutputSet`]).
+    #[error(
+        "another ringmesh run is writing into {path}: nothing was computed or written; \
+         wait for it to finish, or choose another output folder (-o)"
+    )]
+    Busy {
+        /// The folder.
+        path: PathBuf,
+    },
+    /// An output file name no file system takes.
+    #[error("`{name}` cannot name an output file: {reason}")]
+    Name {
+        /// The name (its first 80 characters).
+        name: String,
+        /// Why not.
+        reason: &'static str,
+    },
+    /// The output folder cannot be created or written: found before any
+    /// computing.
+    #[error("cannot write into the output folder {path}: {source}")]
+    Unwritable {
+        /// The folder, or the staging folder beside it.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
     /// A value could not be serialised (a non-finite number in JSON, say).
-    #[error("serialising {path}: {source}")]
+    #[error("serialising {}: {source}", output_set::shown(path).display())]
     Json {
         /// The file.
         path: PathBuf,
@@ -50,9 +79,14 @@ pub enum ReportError {
 }
 
 impl ReportError {
-    /// Output failures are never the input's fault.
+    /// Refusals before any computing (a folder in use or not writable, a
+    /// name that cannot be a file's) are the input's; failures while
+    /// writing are not.
     pub fn is_bad_input(&self) -> bool {
-        false
+        matches!(
+            self,
+            ReportError::Busy { .. } | ReportError::Name { .. } | ReportError::Unwritable { .. }
+        )
     }
 }
 
@@ -73,6 +107,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let temporary = parent.join(format!(".{file_name}.{}.tmp", std::process::id()));
+    output_set::register(&temporary);
     let result = (|| {
         let mut file = std::fs::File::create(&temporary)?;
         file.write_all(bytes)?;
@@ -82,6 +117,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
     if result.is_err() {
         let _ = std::fs::remove_file(&temporary);
     }
+    output_set::unregister(&temporary);
     result.map_err(io)
 }
 
@@ -121,45 +157,14 @@ fn without_trailing_zeros(text: &str) -> String {
 /// What a drawing fails with: the plotting backend's error.
 pub type DrawError = Box<dyn std::error::Error + Send + Sync>;
 
-/// Lets `draw` write a file at a temporary path (same folder, same extension, so
-/// format-by-extension writers work), then renames it over `path`; on any
-/// failure the temporary file is removed and `path` left as it was.
-///
-/// # Errors
-/// The folder or the rename refused ([`ReportError::Io`]), or `draw` failed
-/// ([`ReportError::Plot`]).
-pub fn write_atomic_with(
-    path: &Path,
-    draw: impl FnOnce(&Path) -> Result<(), DrawError>,
-) -> Result<(), ReportError> {
-    let io = |source| ReportError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&parent).map_err(io)?;
-    let name = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let extension = path
-        .extension()
-        .map(|e| e.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let temporary = parent.join(format!(".{name}.{}.tmp.{extension}", std::process::id()));
-    let result = draw(&temporary)
-        .map_err(|source| ReportError::Plot {
-            path: path.to_path_buf(),
-            source,
-        })
-        .and_then(|()| std::fs::rename(&temporary, path).map_err(io));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result
+/// A run's JSON report with its [`RunRecord`] first (`"run": {…}`).
+#[derive(Serialize)]
+pub struct WithRun<'a, T: Serialize> {
+    /// The run's identifier and files.
+    pub run: &'a RunRecord,
+    /// The report.
+    #[serde(flatten)]
+    pub report: &'a T,
 }
 
 /// Serialises `value` as pretty JSON and writes it atomically.

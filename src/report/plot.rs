@@ -7,7 +7,7 @@ use std::sync::Once;
 
 use plotters::prelude::*;
 
-use super::{write_atomic, write_atomic_with, DrawError, FrontRow, ReportError};
+use super::{write_atomic, DrawError, FrontRow, ReportError};
 use crate::scene::TrussModel;
 use crate::study::{pareto_optimal, ApertureResult, Knob, StudyRow};
 
@@ -144,15 +144,19 @@ where
 }
 
 /// Draws `$draw(area, args…)` — generic over the plotters backend — as a PNG
-/// of `$size` pixels and as an SVG, each file written atomically (the PNG
-/// backend draws to the temporary path of `write_atomic_with`).
+/// of `$size` pixels (drawn in memory) and as an SVG, each file written
+/// atomically.
 macro_rules! png_and_svg {
     ($draw:ident, $size:expr, $png:expr, $svg:expr $(, $arg:expr)*) => {{
         register_font();
         let (png, svg, size): (&Path, &Path, (u32, u32)) = ($png, $svg, $size);
-        write_atomic_with(png, |temporary| {
-            $draw(BitMapBackend::new(temporary, size).into_drawing_area() $(, $arg)*)
-        })?;
+        let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+        $draw(BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area() $(, $arg)*)
+            .map_err(|source| ReportError::Plot {
+                path: png.to_path_buf(),
+                source,
+            })?;
+        write_atomic(png, &png_bytes(&rgb, size, png)?)?;
         let mut text = String::new();
         $draw(SVGBackend::with_string(&mut text, size).into_drawing_area() $(, $arg)*)
             .map_err(|source| ReportError::Plot {
@@ -630,13 +634,32 @@ where
 /// hinges) drawn.
 pub fn surface_plot(figure: &SurfaceFigure, png: &Path) -> Result<(), ReportError> {
     register_font();
-    let width = 560 * (figure.panels.len() as u32 + 1) + 170;
-    write_atomic_with(png, |temporary| {
-        draw_surface(
-            BitMapBackend::new(temporary, (width, 640)).into_drawing_area(),
-            figure,
-        )
-    })
+    let size = (560 * (figure.panels.len() as u32 + 1) + 170, 640);
+    let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+    draw_surface(
+        BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area(),
+        figure,
+    )
+    .map_err(|source| ReportError::Plot {
+        path: png.to_path_buf(),
+        source,
+    })?;
+    write_atomic(png, &png_bytes(&rgb, size, png)?)
+}
+
+/// The PNG file of an RGB image of `size` pixels, in memory: the file is
+/// written by [`write_atomic`], whose errors name the cause plainly (the
+/// bitmap backend's own writer reports `ImageError(IoError(…))`).
+fn png_bytes(rgb: &[u8], size: (u32, u32), path: &Path) -> Result<Vec<u8>, ReportError> {
+    use image::ImageEncoder;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(rgb, size.0, size.1, image::ColorType::Rgb8)
+        .map_err(|e| ReportError::Plot {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })?;
+    Ok(bytes)
 }
 
 /// Floor of a logarithmic ratio-error axis (the reference itself has 0).

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::report::{aperture_csv, aperture_plot, write_atomic, write_json};
+use crate::report::{aperture_csv, aperture_plot, write_atomic, write_json, OutputSet};
 use crate::scene::Scene;
 use crate::study::{run_aperture_study, ApertureResult, ApertureSettings};
 use crate::Error;
@@ -38,10 +38,16 @@ pub fn apertures(
         || Path::new("results").join(&scene.name).join("apertures"),
         Path::to_path_buf,
     );
+    let table = [
+        "apertures.png",
+        "apertures.svg",
+        "apertures.csv",
+        "apertures.json",
+    ];
+    let mut set = OutputSet::begin(&dir, &table)?;
     let results = run_aperture_study(&scene, settings, observe)?;
-    let mut written = Vec::new();
     for r in &results {
-        let path = dir.join(format!("{}.toml", r.scene.name));
+        let path = set.add(&format!("{}.toml", r.scene.name))?;
         let text = format!(
             "# {} scaled to a {} m aperture and its truss sized for a limit margin of {} by \
              `ringmesh apertures`.\n{}",
@@ -51,7 +57,6 @@ pub fn apertures(
             r.scene.to_toml()?
         );
         write_atomic(&path, text.as_bytes())?;
-        written.push(path);
     }
     let title = format!(
         "{} (F/D {:.3}): designs as built on the exact truss, tubes sized for a margin of {}",
@@ -59,11 +64,11 @@ pub fn apertures(
         scene.reflector.focal_length_m / scene.reflector.aperture_diameter_m,
         settings.margin
     );
-    let [png, svg, csv, json] =
-        ["png", "svg", "csv", "json"].map(|e| dir.join(format!("apertures.{e}")));
+    let [png, svg, csv, json] = table.map(|name| set.path(name));
     aperture_plot(&results, &title, &png, &svg)?;
     write_atomic(&csv, aperture_csv(&results).as_bytes())?;
     write_json(&json, &results)?;
-    written.extend([csv, json, png, svg]);
+    set.stamp()?;
+    let written = set.commit()?;
     Ok(AperturesOutcome { results, written })
 }

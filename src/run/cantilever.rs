@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::frame::cantilever::{self, CantileverRow};
 use crate::frame::FrameFileError;
 use crate::mechanics::ElementKind;
-use crate::report::write_json;
+use crate::report::OutputSet;
 use crate::Error;
 
 /// One row of `ringmesh cantilever`: the engine's row and the paper's result
@@ -66,7 +66,9 @@ pub fn cantilever(
         rows,
     };
     if let Some(dir) = output_dir {
-        write_json(&dir.join("cantilever.json"), &table)?;
+        let mut bytes = serde_json::to_vec_pretty(&table).expect("a table serialises");
+        bytes.push(b'\n');
+        OutputSet::write_one(dir, "cantilever.json", &bytes)?;
     }
     Ok(table)
 }

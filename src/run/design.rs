@@ -10,7 +10,7 @@ use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::report::{
     assembly_vtu, cables_csv, convergence_csv, convergence_plot, surface_plot, write_atomic,
-    write_json, NodePanel, SurfaceFigure,
+    write_json, NodePanel, OutputSet, SurfaceFigure, WithRun,
 };
 use crate::scene::Scene;
 use crate::verify::Verification;
@@ -28,11 +28,14 @@ pub struct DesignOutcome {
 /// `ringmesh design`: reads the scene, runs [`crate::design::run`] and writes
 /// `design.json`, `cables.csv`, `convergence.csv/.png/.svg`,
 /// `surface-error.png` and `model.vtu` into `output_dir` (default
-/// `results/<scene>/`). `observe` sees each outer iteration.
+/// `results/<scene>/`), all together or none ([`OutputSet`]: the folder is
+/// locked and checked before any computing). `observe` sees each outer
+/// iteration.
 ///
 /// # Errors
-/// The scene's, the design's and the writers' errors; nothing is written
-/// unless everything was computed.
+/// The scene's, the design's and the writers' errors, and a folder in use
+/// or not writable (before computing); nothing is written unless
+/// everything was computed.
 pub fn design(
     scene_path: &Path,
     settings: &DesignSettings,
@@ -42,17 +45,11 @@ pub fn design(
     let clock = Instant::now();
     let scene = Scene::read(scene_path)?;
     let read_s = clock.elapsed().as_secs_f64();
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let set = OutputSet::begin(&dir, &FILES)?;
     let mut run = crate::design::run(&scene, settings, observe)?;
     run.report.timings.read_s = read_s;
-    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
-    let written = write_design(
-        &dir,
-        &scene,
-        &run.mesh,
-        &run.network,
-        &mut run.report,
-        clock,
-    )?;
+    let written = write_design(set, &scene, &run.mesh, &run.network, &mut run.report, clock)?;
     Ok(DesignOutcome {
         report: run.report,
         written,
@@ -117,11 +114,23 @@ fn surface_figure(
     }
 }
 
-/// The files of `ringmesh design`, each written atomically, `design.json`
-/// last, with the time spent writing the others and the command's wall time
+/// The files of `ringmesh design`.
+const FILES: [&str; 7] = [
+    "design.json",
+    "cables.csv",
+    "convergence.csv",
+    "convergence.png",
+    "convergence.svg",
+    "surface-error.png",
+    "model.vtu",
+];
+
+/// The files of `ringmesh design` written into `set` and swapped in as one:
+/// `design.json` last, with the run's record of the others (identifier,
+/// sizes, hashes), the time spent writing them and the command's wall time
 /// since `clock` in its timings.
 fn write_design(
-    dir: &Path,
+    set: OutputSet,
     scene: &Scene,
     mesh: &ReflectorMesh,
     network: &Network,
@@ -129,7 +138,7 @@ fn write_design(
     clock: Instant,
 ) -> Result<Vec<PathBuf>, Error> {
     let writing = Instant::now();
-    let path = |name: &str| dir.join(name);
+    let path = |name: &str| set.path(name);
     let series: Vec<(String, Vec<(usize, f64)>)> = report
         .runs
         .iter()
@@ -172,19 +181,10 @@ fn write_design(
         &path("cables.csv"),
         cables_csv(network, &report.net, &scene.cables).as_bytes(),
     )?;
+    set.stamp()?;
+    let run = set.manifest()?;
     report.timings.writing_s = writing.elapsed().as_secs_f64();
     report.timings.total_s = clock.elapsed().as_secs_f64();
-    write_json(&path("design.json"), report)?;
-    Ok([
-        "design.json",
-        "cables.csv",
-        "convergence.csv",
-        "convergence.png",
-        "convergence.svg",
-        "surface-error.png",
-        "model.vtu",
-    ]
-    .iter()
-    .map(|n| path(n))
-    .collect())
+    write_json(&path("design.json"), &WithRun { run: &run, report })?;
+    Ok(set.commit()?)
 }

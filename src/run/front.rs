@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use super::{default_output_dir, write_shard, Progress};
 use crate::design::scene_problem;
-use crate::report::{front_csv, front_plot, front_row, write_atomic, FrontRow, FRONT_COLUMNS};
+use crate::report::{
+    front_csv, front_plot, front_row, write_atomic, FrontRow, OutputSet, FRONT_COLUMNS,
+};
 use crate::scene::Scene;
 use crate::shard::Shard;
 use crate::study;
@@ -25,6 +27,13 @@ pub fn front(
     progress: &dyn Progress,
 ) -> Result<(Vec<FrontPoint>, Vec<PathBuf>), Error> {
     let scene = Scene::read(scene_path)?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    // A shard writes one file under the folder's lock once computed; the
+    // whole front takes the folder before computing.
+    let set = match shard {
+        Some(_) => None,
+        None => Some(OutputSet::begin(&dir, &FILES)?),
+    };
     let (_, problem) = scene_problem(&scene)?;
     let jobs = front_jobs(&problem, solvers, points);
     let indices = shard.unwrap_or(Shard::WHOLE).points(jobs.len());
@@ -41,8 +50,8 @@ pub fn front(
             p.knob
         ));
     });
-    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
-    if let Some(shard) = shard {
+    let Some(set) = set else {
+        let shard = shard.unwrap_or(Shard::WHOLE);
         let settings = serde_json::json!({
             "solvers": solvers.iter().map(study::value_name).collect::<Vec<_>>(),
             "points": points,
@@ -64,33 +73,39 @@ pub fn front(
             &rows,
         )?;
         return Ok((front, vec![path]));
-    }
+    };
     let rows: Vec<FrontRow> = front.iter().filter_map(FrontRow::of).collect();
     let failed: Vec<(String, f64)> = front
         .iter()
         .filter(|p| p.outcome.is_err())
         .map(|p| (study::value_name(&p.solver), p.knob))
         .collect();
-    let paths = write_front(&dir, &scene.name, &rows, Some(&failed), &front_csv(&rows))?;
+    let paths = write_front(set, &scene.name, &rows, Some(&failed), &front_csv(&rows))?;
     Ok((front, paths))
 }
 
+/// The files of a whole front.
+pub(crate) const FILES: [&str; 3] = ["front.csv", "front.png", "front.svg"];
+
 /// `front.csv` (the table `csv`), `front.png`, `front.svg` (drawn from `rows`,
-/// the `failed` points — solver, knob — listed when known).
+/// the `failed` points — solver, knob — listed when known), written into
+/// `set` (begun with [`FILES`]) and swapped in.
 pub(crate) fn write_front(
-    dir: &Path,
+    set: OutputSet,
     scene: &str,
     rows: &[FrontRow],
     failed: Option<&[(String, f64)]>,
     csv: &str,
 ) -> Result<Vec<PathBuf>, Error> {
-    let paths = [
-        dir.join("front.csv"),
-        dir.join("front.png"),
-        dir.join("front.svg"),
-    ];
     let title = format!("{scene}: tension uniformity against surface accuracy");
-    front_plot(rows, failed, &title, &paths[1], &paths[2])?;
-    write_atomic(&paths[0], csv.as_bytes())?;
-    Ok(paths.to_vec())
+    front_plot(
+        rows,
+        failed,
+        &title,
+        &set.path("front.png"),
+        &set.path("front.svg"),
+    )?;
+    write_atomic(&set.path("front.csv"), csv.as_bytes())?;
+    set.stamp()?;
+    Ok(set.commit()?)
 }

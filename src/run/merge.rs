@@ -3,8 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use super::front::write_front;
-use super::study::write_study;
+use super::front::{self, write_front};
+use super::study::{self, write_study};
+use crate::report::OutputSet;
 use crate::report::{parse_front_row, parse_study_row, FrontRow};
 use crate::shard::{self, ShardError};
 use crate::study::StudyRow;
@@ -72,8 +73,14 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOu
         );
         // The plots are drawn from the parsed rows; the table is the shards' text.
         let written = match table {
-            Table::Front(rows) => write_front(&dir, &m.header.scene, &rows, None, &m.csv())?,
-            Table::Study(rows) => write_study(&dir, &m.header.scene, &rows, &m.csv())?,
+            Table::Front(rows) => {
+                let set = OutputSet::begin(&dir, &front::FILES)?;
+                write_front(set, &m.header.scene, &rows, None, &m.csv())?
+            }
+            Table::Study(rows) => {
+                let set = OutputSet::begin(&dir, &study::FILES)?;
+                write_study(set, &m.header.scene, &rows, &m.csv())?
+            }
         };
         outcomes.push(MergeOutcome {
             command: m.header.command.clone(),

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use super::default_output_dir;
 use crate::geometry::build_mesh;
 use crate::network::NetworkSummary;
-use crate::report::{network_vtu, write_atomic, write_json};
+use crate::report::{network_vtu, write_atomic, write_json, OutputSet};
 use crate::scene::Scene;
 use crate::Error;
 
@@ -24,17 +24,17 @@ pub struct MeshOutcome {
 /// interchange format, design positions, initial q) and `mesh.vtu`.
 pub fn mesh(scene_path: &Path, output_dir: Option<&Path>) -> Result<MeshOutcome, Error> {
     let scene = Scene::read(scene_path)?;
-    let mesh = build_mesh(&scene)?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let set = OutputSet::begin(&dir, &["network.json", "mesh.vtu"])?;
+    let mesh = build_mesh(&scene)?;
     let summary = mesh.network.summary();
     let vtu = network_vtu(&mesh.network, None, None);
-    let network_path = dir.join("network.json");
-    let vtu_path = dir.join("mesh.vtu");
-    write_json(&network_path, &mesh.network)?;
-    write_atomic(&vtu_path, vtu.as_bytes())?;
+    write_json(&set.path("network.json"), &mesh.network)?;
+    write_atomic(&set.path("mesh.vtu"), vtu.as_bytes())?;
+    set.stamp()?;
     Ok(MeshOutcome {
         scene: scene.name,
         summary,
-        written: vec![network_path, vtu_path],
+        written: set.commit()?,
     })
 }

@@ -1,5 +1,6 @@
 //! One file per CLI subcommand: read the inputs, call the library, write the
-//! outputs (atomically, and only once everything is computed), and return
+//! outputs (all together or none, into a folder locked and checked before
+//! any computing: [`OutputSet`]), and return
 //! what the command prints. `main.rs` only parses arguments and calls these;
 //! the pipelines themselves live in the library ([`crate::design::run`],
 //! [`crate::study::run_study`], …).
@@ -36,7 +37,7 @@ pub use study::{study, StudyOptions, StudyOutcome, STUDY_STEM};
 pub use truss::truss;
 pub use uniformity::{uniformity, UniformityOutput};
 
-use crate::report::write_atomic;
+use crate::report::OutputSet;
 use crate::scene::Scene;
 use crate::shard::{self, Shard, ShardHeader};
 use crate::Error;
@@ -81,7 +82,10 @@ pub(crate) fn write_shard(
         settings,
         scene_file: serde_json::to_value(scene).expect("a scene serialises"),
     };
-    let path = dir.join(shard.file_name(stem));
-    write_atomic(&path, shard::shard_csv(&header, columns, rows).as_bytes())?;
-    Ok(path)
+    let csv = shard::shard_csv(&header, columns, rows);
+    Ok(OutputSet::write_one(
+        dir,
+        &shard.file_name(stem),
+        csv.as_bytes(),
+    )?)
 }

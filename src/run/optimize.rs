@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::default_output_dir;
 use crate::design::{default_solver, scene_problem};
-use crate::report::{cables_csv, write_atomic, write_json};
+use crate::report::{cables_csv, write_atomic, write_json, OutputSet, WithRun};
 use crate::scene::Scene;
 use crate::uniformity::{Design, SolverKind};
 use crate::Error;
@@ -29,19 +29,24 @@ pub fn optimize(
     output_dir: Option<&Path>,
 ) -> Result<(Design, Vec<PathBuf>), Error> {
     let scene = Scene::read(scene_path)?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let set = OutputSet::begin(&dir, &["design.json", "cables.csv"])?;
     let (mesh, problem) = scene_problem(&scene)?;
     let solver = solver.unwrap_or_else(|| default_solver(&scene));
     let design = solver.build(None).solve(&problem)?.feasible()?;
-    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     let csv = cables_csv(&mesh.network, &design, &scene.cables);
-    let (json_path, csv_path) = (dir.join("design.json"), dir.join("cables.csv"));
+    write_atomic(&set.path("cables.csv"), csv.as_bytes())?;
+    let run = set.manifest()?;
+    let file = DesignFile {
+        scene: &scene.name,
+        design: &design,
+    };
     write_json(
-        &json_path,
-        &DesignFile {
-            scene: &scene.name,
-            design: &design,
+        &set.path("design.json"),
+        &WithRun {
+            run: &run,
+            report: &file,
         },
     )?;
-    write_atomic(&csv_path, csv.as_bytes())?;
-    Ok((design, vec![json_path, csv_path]))
+    Ok((design, set.commit()?))
 }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use super::default_output_dir;
 use crate::design::DesignSettings;
-use crate::report::{sizing_csv, write_atomic};
+use crate::report::{sizing_csv, write_atomic, OutputSet};
 use crate::scene::Scene;
 use crate::sizing::{catalogue, size_truss, SectionTrial, Sections, Sizing};
 use crate::Error;
@@ -45,20 +45,24 @@ pub fn size(
         },
     };
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    let sized_name = format!("{}-sized", scene.name);
+    let toml_name = format!("{sized_name}.toml");
+    let set = OutputSet::begin(&dir, &["sizing.csv", &toml_name])?;
     let mut sizing = size_truss(&scene, &sections, margin, settings, observe)?;
-    sizing.scene.name = format!("{}-sized", scene.name);
-    let csv = dir.join("sizing.csv");
-    let toml = dir.join(format!("{}.toml", sizing.scene.name));
+    sizing.scene.name = sized_name;
     let text = format!(
         "# {} with its truss sized by `ringmesh size` for a limit margin of {}.\n{}",
         scene.name,
         margin,
         sizing.scene.to_toml()?
     );
-    write_atomic(&csv, sizing_csv(&sizing.trials).as_bytes())?;
-    write_atomic(&toml, text.as_bytes())?;
+    write_atomic(
+        &set.path("sizing.csv"),
+        sizing_csv(&sizing.trials).as_bytes(),
+    )?;
+    write_atomic(&set.path(&toml_name), text.as_bytes())?;
     Ok(SizeOutcome {
         sizing,
-        written: vec![csv, toml],
+        written: set.commit()?,
     })
 }

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::{default_output_dir, write_shard, Progress};
-use crate::report::{study_csv, study_plot, study_row, write_atomic, STUDY_COLUMNS};
+use crate::report::{study_csv, study_plot, study_row, write_atomic, OutputSet, STUDY_COLUMNS};
 use crate::scene::{Scene, TrussModel};
 use crate::shard::Shard;
 use crate::study::{self, Knob, StudyRow, StudySettings};
@@ -104,6 +104,13 @@ pub fn study(
     let scene = Scene::read(scene_path)?;
     let settings = options.settings(&scene);
     settings.validate()?;
+    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    // A shard writes one file under the folder's lock once computed; the
+    // whole study takes the folder before computing.
+    let set = match shard {
+        Some(_) => None,
+        None => Some(OutputSet::begin(&dir, &FILES)?),
+    };
     let total = study::points(&scene, &settings).len();
     let part = shard.unwrap_or(Shard::WHOLE);
     let runs = part.points(total).len() + usize::from(!part.includes(0));
@@ -116,9 +123,9 @@ pub fn study(
         let point = format!("{} {}", r.knob.name(), r.value);
         progress.step(&format!("{}: {outcome}", point.trim_end()));
     })?;
-    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
-    let written = match shard {
-        Some(shard) => {
+    let written = match set {
+        None => {
+            let shard = shard.unwrap_or(Shard::WHOLE);
             let lines: Vec<(usize, String)> =
                 rows.iter().map(|(k, r)| (*k, study_row(r))).collect();
             let settings = serde_json::to_value(&settings).expect("settings serialise");
@@ -134,9 +141,9 @@ pub fn study(
                 &lines,
             )?]
         }
-        None => {
+        Some(set) => {
             let table: Vec<StudyRow> = rows.iter().map(|(_, r)| r.clone()).collect();
-            write_study(&dir, &scene.name, &table, &study_csv(&table))?
+            write_study(set, &scene.name, &table, &study_csv(&table))?
         }
     };
     Ok(StudyOutcome {
@@ -147,21 +154,26 @@ pub fn study(
     })
 }
 
-/// `accuracy-vs-time.csv` (the table `csv`), `.png`, `.svg` (drawn from `rows`).
+/// The files of a whole study (stem [`STUDY_STEM`]).
+pub(crate) const FILES: [&str; 3] = [
+    "accuracy-vs-time.csv",
+    "accuracy-vs-time.png",
+    "accuracy-vs-time.svg",
+];
+
+/// `accuracy-vs-time.csv` (the table `csv`), `.png`, `.svg` (drawn from
+/// `rows`), written into `set` (begun with [`FILES`]) and swapped in.
 pub(crate) fn write_study(
-    dir: &Path,
+    set: OutputSet,
     scene: &str,
     rows: &[StudyRow],
     csv: &str,
 ) -> Result<Vec<PathBuf>, Error> {
-    let paths = [
-        dir.join(format!("{STUDY_STEM}.csv")),
-        dir.join(format!("{STUDY_STEM}.png")),
-        dir.join(format!("{STUDY_STEM}.svg")),
-    ];
+    let [csv_path, png, svg] = FILES.map(|name| set.path(name));
     let title =
         format!("{scene}: what accuracy costs in time (designs as built on the reference truss)");
-    study_plot(rows, &title, &paths[1], &paths[2])?;
-    write_atomic(&paths[0], csv.as_bytes())?;
-    Ok(paths.to_vec())
+    study_plot(rows, &title, &png, &svg)?;
+    write_atomic(&csv_path, csv.as_bytes())?;
+    set.stamp()?;
+    Ok(set.commit()?)
 }

@@ -30,6 +30,9 @@ use serde::{Deserialize, Serialize};
 
 pub use rod_properties::{RodKind, RodProperties, RodPropertiesError, RodStiffness, TrussRod};
 
+/// Longest scene name: it names the results folder and files made from it.
+pub const MAX_NAME_LEN: usize = 128;
+
 /// A whole reflector scene: the input of one run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -436,6 +439,17 @@ impl Scene {
                     "{:?} must be non-empty and use only letters, digits, '-', '_' and '.' \
                      (it names the results folder)",
                     self.name
+                ),
+            ));
+        }
+        if self.name.len() > MAX_NAME_LEN {
+            return Err(SceneError::invalid(
+                "name",
+                format!(
+                    "{} characters, at most {MAX_NAME_LEN}: it names the results folder and \
+                     files (`<name>-sized.toml`, `<name>-at-100m.toml`) that file systems \
+                     limit to 255 bytes",
+                    self.name.len()
                 ),
             ));
         }
