@@ -27,13 +27,80 @@ pub fn norm_inf(a: &[f64]) -> f64 {
 /// Euclidean norm of a 3-vector.
 #[inline]
 pub fn norm3(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+    let squared = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if squared.is_finite() && squared >= f64::MIN_POSITIVE {
+        squared.sqrt()
+    } else {
+        // Components beyond 1e154 overflow when squared, below 1e-154
+        // underflow: `hypot` scales.
+        v[0].hypot(v[1]).hypot(v[2])
+    }
 }
 
 /// `a − b` of two 3-vectors.
 #[inline]
 pub fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// A linear-algebra failure in words, for messages a user reads (faer's
+/// errors print as `Debug`: `Numeric(NonPositivePivot { index: 3 })`).
+pub trait Plain {
+    /// What went wrong, in words.
+    fn plain(&self) -> String;
+}
+
+impl Plain for faer::sparse::FaerError {
+    fn plain(&self) -> String {
+        match self {
+            faer::sparse::FaerError::IndexOverflow => {
+                "the problem is too large to index (index overflow)".to_string()
+            }
+            faer::sparse::FaerError::OutOfMemory => "out of memory".to_string(),
+            _ => format!("{self}"),
+        }
+    }
+}
+
+impl Plain for faer::sparse::CreationError {
+    fn plain(&self) -> String {
+        match self {
+            faer::sparse::CreationError::Generic(e) => e.plain(),
+            faer::sparse::CreationError::OutOfBounds { row, col } => {
+                format!("entry ({row}, {col}) outside the matrix")
+            }
+        }
+    }
+}
+
+impl Plain for faer::sparse::linalg::LltError {
+    fn plain(&self) -> String {
+        match self {
+            faer::sparse::linalg::LltError::Numeric(e) => e.plain(),
+            faer::sparse::linalg::LltError::Generic(e) => e.plain(),
+        }
+    }
+}
+
+impl Plain for faer::linalg::cholesky::llt::factor::LltError {
+    fn plain(&self) -> String {
+        match self {
+            faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
+                format!("not positive definite (pivot {index} is not positive)")
+            }
+        }
+    }
+}
+
+impl Plain for faer::sparse::linalg::LuError {
+    fn plain(&self) -> String {
+        match self {
+            faer::sparse::linalg::LuError::SymbolicSingular { index } => {
+                format!("structurally singular (no pivot at step {index})")
+            }
+            faer::sparse::linalg::LuError::Generic(e) => e.plain(),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, Symbol
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, Mat, MatMut, Par, Side};
 
-use crate::algebra::norm3;
+use crate::algebra::{norm3, Plain};
 use crate::network::{edges_vectors, Network, NetworkError};
 
 /// Marks "no such index" in the dense index maps below.
@@ -53,7 +53,11 @@ pub enum FdmError {
         expected: usize,
     },
     /// A force density is not finite and positive.
-    #[error("`q[{edge}]` = {value}: force densities must be finite and > 0")]
+    #[error(
+        "`q[{edge}]` = {value:e}: force densities must be finite and at least {:e} N/m \
+         (the smallest normal double)",
+        f64::MIN_POSITIVE
+    )]
     InvalidQ {
         /// The cable.
         edge: usize,
@@ -74,6 +78,19 @@ pub enum FdmError {
     NonFinite {
         /// The first node with a non-finite coordinate.
         node: usize,
+    },
+    /// Positions are finite but a force is not: `q` times the geometry
+    /// overflows double precision.
+    #[error(
+        "the forward solve's {what} is not finite: force densities up to {max_q:e} N/m \
+         on this geometry overflow double precision"
+    )]
+    Overflow {
+        /// The first non-finite quantity (a cable's tension, a reaction, a
+        /// node's residual).
+        what: String,
+        /// The largest force density.
+        max_q: f64,
     },
 }
 
@@ -138,7 +155,7 @@ impl FdmStructure {
             )
             .map_err(|e| FdmError::NotPositiveDefinite {
                 n_free: free.len(),
-                reason: format!("symbolic factorisation: {e:?}"),
+                reason: format!("symbolic factorisation: {}", e.plain()),
             })?;
             Some(Arc::new(symbolic))
         };
@@ -242,7 +259,7 @@ impl FdmStructure {
         if let Some((edge, &value)) = q
             .iter()
             .enumerate()
-            .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+            .find(|(_, v)| !(v.is_finite() && **v >= f64::MIN_POSITIVE))
         {
             return Err(FdmError::InvalidQ { edge, value });
         }
@@ -267,6 +284,12 @@ impl FdmStructure {
             None => None,
             Some(symbolic) => {
                 let values = self.d_values(q);
+                if values.iter().any(|v| !v.is_finite()) {
+                    return Err(FdmError::Overflow {
+                        what: "matrix D = C_fᵀ Q C_f".to_string(),
+                        max_q: q.iter().copied().fold(0.0, f64::max),
+                    });
+                }
                 let d = SparseColMatRef::new(self.d_pattern.as_ref(), &values);
                 let mut l_values = vec![0.0; symbolic.len_val()];
                 let scratch = symbolic
@@ -286,7 +309,7 @@ impl FdmStructure {
                     )
                     .map_err(|e| FdmError::NotPositiveDefinite {
                         n_free,
-                        reason: format!("{e:?}"),
+                        reason: e.plain(),
                     })?;
                 let factor = Factor {
                     symbolic: Arc::clone(symbolic),
@@ -311,7 +334,29 @@ impl FdmStructure {
         if let Some(factor) = &factor {
             self.refine(factor, q, &mut xyz, loads, rhs);
         }
-        Ok(Equilibrium::new(self, q, xyz, loads, factor))
+        let equilibrium = Equilibrium::new(self, q, xyz, loads, factor);
+        let overflow = |what: String| FdmError::Overflow {
+            what,
+            max_q: q.iter().copied().fold(0.0, f64::max),
+        };
+        if let Some(k) = equilibrium
+            .edges_forces_n
+            .iter()
+            .position(|t| !t.is_finite())
+        {
+            return Err(overflow(format!("tension of cable {k}")));
+        }
+        let finite = |v: &[f64; 3]| v.iter().all(|c| c.is_finite());
+        if let Some(g) = equilibrium.reactions_n.iter().position(|r| !finite(r)) {
+            return Err(overflow(format!(
+                "reaction at fixed node {}",
+                self.fixed[g]
+            )));
+        }
+        if let Some(i) = equilibrium.residuals_n.iter().position(|r| !finite(r)) {
+            return Err(overflow(format!("residual at node {}", self.free[i])));
+        }
+        Ok(equilibrium)
     }
 
     /// The out-of-balance force at every free node in *edge form*,

@@ -158,6 +158,78 @@ pub enum NetworkError {
         /// The node.
         node: usize,
     },
+    /// No node or no cable.
+    #[error("the network is empty: {nodes} nodes, {edges} cables")]
+    Empty {
+        /// Its nodes.
+        nodes: usize,
+        /// Its cables.
+        edges: usize,
+    },
+    /// Every node is fixed: nothing to solve for.
+    #[error("all {nodes} nodes are fixed: the network has no free node to find")]
+    NoFreeNode {
+        /// Its nodes.
+        nodes: usize,
+    },
+    /// Two cables join the same two nodes.
+    #[error(
+        "`edges[{first}]` and `edges[{second}]` both join nodes {i} and {j}{}: \
+         one cable per pair of nodes",
+        if *.reversed { " (the second reversed)" } else { "" }
+    )]
+    DuplicateEdge {
+        /// The first cable.
+        first: usize,
+        /// The second.
+        second: usize,
+        /// Its nodes, as the first lists them.
+        i: usize,
+        /// The other.
+        j: usize,
+        /// The second lists them the other way round.
+        reversed: bool,
+    },
+    /// Two nodes at the same position.
+    #[error("fixed nodes {first} and {second} are at the same position {position:?} m")]
+    CoincidentNodes {
+        /// The first node.
+        first: usize,
+        /// The second.
+        second: usize,
+        /// Where.
+        position: [f64; 3],
+    },
+    /// A force density too small to be a normal double.
+    #[error(
+        "`q[{edge}]` = {value:e} is subnormal: force densities must be at least \
+         {:e} N/m (the smallest normal double), below which they carry no precision",
+        f64::MIN_POSITIVE
+    )]
+    SubnormalQ {
+        /// The edge.
+        edge: usize,
+        /// The value found.
+        value: f64,
+    },
+    /// Force densities spread beyond what double precision can balance.
+    #[error(
+        "force densities span {ratio:.1e} (`q[{min_edge}]` = {min:e}, `q[{max_edge}]` = {max:e} \
+         N/m), beyond the 1/ε = 4.5e15 of double precision: a cable's force vanishes in the \
+         rounding of its neighbours'"
+    )]
+    QSpread {
+        /// The cable with the smallest force density.
+        min_edge: usize,
+        /// Its force density.
+        min: f64,
+        /// The cable with the largest.
+        max_edge: usize,
+        /// Its force density.
+        max: f64,
+        /// `max/min`.
+        ratio: f64,
+    },
     /// A force density is zero or negative.
     #[error("`q[{edge}]` = {value}: force densities must be > 0")]
     NonPositiveQ {
@@ -178,6 +250,16 @@ pub enum NetworkError {
         /// How many there are.
         count: usize,
     },
+}
+
+/// The first two of the nodes `among` at exactly the same position
+/// (bitwise, with −0 as +0), in the order of `among`.
+pub fn coincident_nodes(nodes: &[[f64; 3]], among: &[usize]) -> Option<(usize, usize)> {
+    let key = |p: &[f64; 3]| p.map(|c| (c + 0.0).to_bits());
+    let mut places = std::collections::HashMap::with_capacity(among.len());
+    among
+        .iter()
+        .find_map(|&i| places.insert(key(&nodes[i]), i).map(|first| (first, i)))
 }
 
 /// At most this many offending nodes are listed in an error.
@@ -261,6 +343,9 @@ impl Network {
                 });
             }
         }
+        if n == 0 || m == 0 {
+            return Err(NetworkError::Empty { nodes: n, edges: m });
+        }
         let not_finite = |v: &[f64; 3]| v.iter().any(|c| !c.is_finite());
         if let Some(index) = self.nodes.iter().position(not_finite) {
             return Err(NetworkError::NotFinite {
@@ -301,6 +386,33 @@ impl Network {
                 return Err(NetworkError::FixedTwice { node });
             }
         }
+        if self.fixed.len() == n {
+            return Err(NetworkError::NoFreeNode { nodes: n });
+        }
+        let mut pairs = std::collections::HashMap::with_capacity(m);
+        for (second, &[i, j]) in self.edges.iter().enumerate() {
+            if let Some(&first) = pairs.get(&(i.min(j), i.max(j))) {
+                let [a, b] = self.edges[first];
+                return Err(NetworkError::DuplicateEdge {
+                    first,
+                    second,
+                    i: a,
+                    j: b,
+                    reversed: a != i,
+                });
+            }
+            pairs.insert((i.min(j), i.max(j)), second);
+        }
+        // Two supports at one point (the free nodes' positions are only a
+        // start for the forward solve; a prescribed geometry checks them all:
+        // `coincident_nodes`).
+        if let Some((first, second)) = coincident_nodes(&self.nodes, &self.fixed) {
+            return Err(NetworkError::CoincidentNodes {
+                first,
+                second,
+                position: self.nodes[first],
+            });
+        }
         for (edge, &value) in self.q.iter().enumerate() {
             if !value.is_finite() {
                 return Err(NetworkError::NotFinite {
@@ -310,6 +422,24 @@ impl Network {
             }
             if value <= 0.0 {
                 return Err(NetworkError::NonPositiveQ { edge, value });
+            }
+            if value < f64::MIN_POSITIVE {
+                return Err(NetworkError::SubnormalQ { edge, value });
+            }
+        }
+        let by_q = |a: &(usize, &f64), b: &(usize, &f64)| a.1.total_cmp(b.1);
+        if let (Some((min_edge, &min)), Some((max_edge, &max))) = (
+            self.q.iter().enumerate().min_by(by_q),
+            self.q.iter().enumerate().max_by(by_q),
+        ) {
+            if max / min > 1.0 / f64::EPSILON {
+                return Err(NetworkError::QSpread {
+                    min_edge,
+                    min,
+                    max_edge,
+                    max,
+                    ratio: max / min,
+                });
             }
         }
         let unanchored = self.unanchored_nodes();
@@ -495,6 +625,79 @@ mod tests {
         net.q[2] = 0.0;
         let err = net.validate().unwrap_err().to_string();
         assert!(err.contains("q[2]"), "{err}");
+    }
+
+    /// Issue 19, item 8 and the honest-number items: each refused, naming
+    /// what is at fault.
+    #[test]
+    fn degenerate_networks_are_refused_naming_the_culprits() {
+        let refused = |net: Network| net.validate().unwrap_err();
+        let mut dup = triangle();
+        dup.edges.push([1, 0]);
+        dup.q.push(1.0);
+        assert!(matches!(
+            refused(dup),
+            NetworkError::DuplicateEdge {
+                first: 0,
+                second: 3,
+                i: 0,
+                j: 1,
+                reversed: true
+            }
+        ));
+        let mut same = triangle();
+        same.nodes[1] = [0.0, -0.0, 0.0];
+        assert!(matches!(
+            refused(same),
+            NetworkError::CoincidentNodes {
+                first: 0,
+                second: 1,
+                ..
+            }
+        ));
+        // A free node's position is only the forward solve's start.
+        let mut start = triangle();
+        start.nodes[2] = start.nodes[0];
+        start.validate().unwrap();
+        let mut all = triangle();
+        all.fixed = vec![0, 1, 2];
+        assert!(matches!(
+            refused(all),
+            NetworkError::NoFreeNode { nodes: 3 }
+        ));
+        let empty = Network {
+            nodes: vec![],
+            edges: vec![],
+            fixed: vec![],
+            q: vec![],
+            loads: None,
+            groups: None,
+        };
+        assert!(matches!(refused(empty), NetworkError::Empty { .. }));
+        let mut tiny = triangle();
+        tiny.q[1] = 5e-324;
+        assert!(matches!(
+            refused(tiny),
+            NetworkError::SubnormalQ { edge: 1, .. }
+        ));
+        let mut spread = triangle();
+        spread.q[2] = 1e16;
+        let e = refused(spread);
+        assert!(
+            matches!(
+                e,
+                NetworkError::QSpread {
+                    min_edge: 0,
+                    max_edge: 2,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // Within double precision's reach: accepted.
+        let mut wide = triangle();
+        wide.q[2] = 1e15;
+        wide.validate().unwrap();
     }
 
     #[test]

@@ -148,6 +148,8 @@ pub struct Merged {
     pub rows: Vec<String>,
     /// The files merged, by shard index.
     pub files: Vec<PathBuf>,
+    /// Which of `files` each row came from.
+    pub origins: Vec<usize>,
 }
 
 impl Merged {
@@ -325,8 +327,13 @@ pub fn find_shards(paths: &[PathBuf]) -> Result<Vec<PathBuf>, ShardError> {
                 .collect();
             in_dir.sort();
             found.extend(in_dir);
-        } else {
+        } else if path.exists() {
             found.push(path.clone());
+        } else {
+            return Err(ShardError::Format {
+                path: path.clone(),
+                reason: "no such file or folder".to_string(),
+            });
         }
     }
     if found.is_empty() {
@@ -440,18 +447,28 @@ fn merge_one(mut files: Vec<ShardFile>) -> Result<Merged, ShardError> {
     let header = first.header.clone();
     let columns = first.columns.clone();
     let paths = files.iter().map(|f| f.path.clone()).collect();
-    let mut rows: Vec<(usize, String)> = files.into_iter().flat_map(|f| f.rows).collect();
+    let mut rows: Vec<(usize, usize, String)> = files
+        .into_iter()
+        .enumerate()
+        .flat_map(|(f, file)| file.rows.into_iter().map(move |(k, row)| (k, f, row)))
+        .collect();
     rows.sort_by_key(|r| r.0);
     if let Some(pair) = rows.windows(2).find(|p| p[0].0 == p[1].0) {
+        let paths: &Vec<PathBuf> = &paths;
         return Err(ShardError::Format {
-            path: PathBuf::from(&header.command),
-            reason: format!("point {} appears twice", pair[0].0),
+            path: paths[pair[1].1].clone(),
+            reason: format!(
+                "point {} appears twice (also in {})",
+                pair[0].0,
+                paths[pair[0].1].display()
+            ),
         });
     }
     Ok(Merged {
         header,
         columns,
-        rows: rows.into_iter().map(|r| r.1).collect(),
+        origins: rows.iter().map(|r| r.1).collect(),
+        rows: rows.into_iter().map(|r| r.2).collect(),
         files: paths,
     })
 }

@@ -312,3 +312,39 @@ fn generator_reproduces_reference_front_net() {
     };
     assert_eq!(pairs(&mesh.network), pairs(&reference));
 }
+
+/// Force densities near the top of double precision (issue 19): at 1e300
+/// N/m the solve keeps its relative accuracy and reports a finite residual
+/// (it printed `inf`, from squaring the residual's components); at 1e308 the
+/// tensions overflow and the solve is an error naming the cable, never a
+/// result with `inf` or `null` in it (it put the node at the origin: the
+/// sum of three 1e308 in `D` is infinite).
+#[test]
+fn force_densities_near_overflow_give_finite_results_or_an_error() {
+    let star = |q: f64| Network {
+        nodes: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.4, 0.3, 0.2],
+        ],
+        edges: vec![[0, 3], [1, 3], [2, 3]],
+        fixed: vec![0, 1, 2],
+        q: vec![q; 3],
+        loads: Some(vec![[0.0; 3], [0.0; 3], [0.0; 3], [0.0, 0.0, -1.0]]),
+        groups: None,
+    };
+    let (_, eq) = solve_network(&star(1e300)).unwrap();
+    let largest = eq.edges_forces_n.iter().copied().fold(0.0, f64::max);
+    assert!(largest > 1e299 && largest.is_finite());
+    let residual = eq.max_residual_n();
+    assert!(
+        residual.is_finite() && residual <= 1e-14 * largest,
+        "{residual:e}"
+    );
+    let e = solve_network(&star(1e308)).unwrap_err().to_string();
+    assert!(
+        e.contains("D = C_fᵀ Q C_f") && e.contains("overflow"),
+        "{e}"
+    );
+}

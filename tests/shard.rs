@@ -260,8 +260,18 @@ fn merging_mismatched_shards_is_refused() {
     std::fs::write(&not_a_shard, "solver,knob\n").unwrap();
     refused(&[&not_a_shard], &out, "not a ringmesh shard");
 
-    // The matching pair merges.
+    // A truncated row is its own shard's fault (it blamed the first shard),
+    // and a path that does not exist is bad input (it exited 1).
     let b = front(&hex, "1/2", "3", &at("b2"));
+    std::fs::create_dir_all(at("g")).unwrap();
+    let broken = at("g").join("front.shard-1-of-2.csv");
+    let text = std::fs::read_to_string(&b).unwrap();
+    let (kept, _) = text.trim_end().rsplit_once(',').unwrap();
+    std::fs::write(&broken, format!("{kept}\n")).unwrap();
+    refused(&[&a, &broken], &out, &broken.display().to_string());
+    refused(&[&a, &at("missing.csv")], &out, "no such file or folder");
+
+    // The matching pair merges.
     succeed(&[
         "merge",
         a.to_str().unwrap(),

@@ -48,6 +48,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
+use crate::algebra::Plain;
 use crate::effects::SceneEffects;
 use crate::fdm::FdmStructure;
 use crate::geometry::ReflectorMesh;
@@ -628,12 +629,13 @@ impl TiedNets {
             status: e,
         };
         let s = SparseColMat::try_new_from_triplets(rows, rows, &triplets)
-            .map_err(|e| failed(format!("{e:?}")))?;
-        let symbolic = SymbolicLlt::try_new(s.symbolic(), Side::Lower)
-            .map_err(|e| failed(format!("{e:?}")))?;
+            .map_err(|e| failed(e.plain()))?;
+        let symbolic =
+            SymbolicLlt::try_new(s.symbolic(), Side::Lower).map_err(|e| failed(e.plain()))?;
         let llt = Llt::try_new_with_symbolic(symbolic, s.as_ref(), Side::Lower).map_err(|e| {
             failed(format!(
-                "the rear net's plan is not stiff with its hinges ({e:?})"
+                "the rear net's plan is not stiff with its hinges: {}",
+                e.plain()
             ))
         })?;
         let mut q = q0.to_vec();

@@ -312,6 +312,14 @@ pub fn build_mesh(scene: &Scene) -> Result<ReflectorMesh, SceneError> {
         loads: None,
         groups: Some(groups.iter().map(|g| g.as_str().to_string()).collect()),
     };
+    // A mesh no force density solve takes is the scene's fault: say so
+    // here, naming the scene, not later naming a cable.
+    network.validate().map_err(|e| {
+        SceneError::invalid(
+            "scene",
+            format!("its mesh is not a valid cable network ({e}); check the truss height, aperture and rings"),
+        )
+    })?;
     Ok(ReflectorMesh {
         network,
         groups,

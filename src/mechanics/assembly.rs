@@ -28,7 +28,7 @@ use super::condensed::{Condensation, CondensedError, CondensedFactor};
 use super::joint::ConstraintRow;
 use super::model::{MechanicsError, Model};
 use super::node::Frame;
-use crate::algebra::norm_inf;
+use crate::algebra::{norm_inf, Plain};
 
 /// Index of a fixed component.
 const FIXED: usize = usize::MAX;
@@ -65,14 +65,46 @@ pub(crate) enum FactorError {
         roundoff: f64,
     },
     /// faer could not build the sparse matrix from the pattern's values.
-    #[error("{0:?}")]
+    #[error("{}", .0.plain())]
     SparseMatrix(faer::sparse::FaerError),
     /// faer's sparse LU failed (a structurally singular matrix, or memory).
-    #[error("{0:?}")]
+    #[error("{}", .0.plain())]
     SparseLu(faer::sparse::linalg::LuError),
+    /// The tangent has entries that are not finite: a modulus, a section or
+    /// a displacement beyond double precision.
+    #[error("{count} entries of the tangent are not finite")]
+    NotFinite {
+        /// How many.
+        count: usize,
+    },
     /// The cable net could not be condensed onto the frame.
     #[error(transparent)]
     Condensed(#[from] CondensedError),
+}
+
+impl From<FactorError> for MechanicsError {
+    /// A tangent that cannot be factored: not finite, out of memory, or
+    /// singular (a mechanism), each said as such.
+    fn from(e: FactorError) -> Self {
+        let out_of_memory = matches!(
+            e,
+            FactorError::SparseMatrix(faer::sparse::FaerError::OutOfMemory)
+                | FactorError::SparseLu(faer::sparse::linalg::LuError::Generic(
+                    faer::sparse::FaerError::OutOfMemory
+                ))
+        );
+        match e {
+            FactorError::NotFinite { .. } => MechanicsError::NotFinite {
+                detail: e.to_string(),
+            },
+            _ if out_of_memory => MechanicsError::OutOfMemory {
+                detail: e.to_string(),
+            },
+            _ => MechanicsError::Mechanism {
+                detail: e.to_string(),
+            },
+        }
+    }
 }
 
 /// The assembled problem's structure: dof numbering, pattern, symbolic factorisation.
@@ -231,7 +263,7 @@ impl System {
         let (symbolic, argsort) =
             SymbolicSparseColMat::try_new_from_indices(n_rows, n_rows, &pattern).map_err(|e| {
                 MechanicsError::Mechanism {
-                    detail: format!("sparsity pattern: {e:?}"),
+                    detail: format!("sparsity pattern: {}", e.plain()),
                 }
             })?;
         // The net's points: translations of nodes that only cables hold.
@@ -261,7 +293,7 @@ impl System {
                 Some(condensation) => SparseFactorisation::Condensed(Arc::new(condensation)),
                 None => SparseFactorisation::Lu(SymbolicLu::try_new(symbolic.as_ref()).map_err(
                     |e| MechanicsError::Mechanism {
-                        detail: format!("symbolic LU: {e:?}"),
+                        detail: format!("symbolic LU: {}", e.plain()),
                     },
                 )?),
             };
@@ -423,6 +455,10 @@ impl System {
     /// A singular tangent: for the dense factor, a pivot below `n ε ‖J‖max`,
     /// the roundoff of a zero pivot (a mechanism).
     pub fn factor(&self, values: &[f64]) -> Result<Factor, FactorError> {
+        let count = values.iter().filter(|v| !v.is_finite()).count();
+        if count > 0 {
+            return Err(FactorError::NotFinite { count });
+        }
         if self.n_rows <= DENSE_ROWS {
             let dense = self.dense_tangent(values);
             let largest = norm_inf(values);

@@ -43,6 +43,7 @@
 
 use std::sync::Arc;
 
+use crate::algebra::Plain;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::linalg::solvers::SolveCore;
@@ -95,7 +96,7 @@ impl Block {
     fn new(n: usize, entries: Vec<(Pair<usize, usize>, Source)>) -> Result<Self, String> {
         let (pairs, source): (Vec<_>, Vec<_>) = entries.into_iter().unzip();
         let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &pairs)
-            .map_err(|e| format!("sparsity pattern: {e:?}"))?;
+            .map_err(|e| format!("sparsity pattern: {}", e.plain()))?;
         Ok(Block {
             symbolic,
             argsort,
@@ -234,14 +235,14 @@ impl Condensation {
                 ..Default::default()
             },
         )
-        .map_err(|e| format!("symbolic LDLᵀ of the net: {e:?}"))?;
+        .map_err(|e| format!("symbolic LDLᵀ of the net: {}", e.plain()))?;
         let s = Block::new(rest.len(), s_entries)?;
         let lu = if rest.is_empty() {
             None
         } else {
             Some(
                 SymbolicLu::try_new(s.symbolic.as_ref())
-                    .map_err(|e| format!("symbolic LU of the frame: {e:?}"))?,
+                    .map_err(|e| format!("symbolic LU of the frame: {}", e.plain()))?,
             )
         };
         Ok(Some(Condensation {
@@ -347,7 +348,7 @@ fn ordering(
         amd::Control::default(),
         MemStack::new(&mut mem),
     )
-    .map_err(|e| format!("AMD ordering of the net: {e:?}"))?;
+    .map_err(|e| format!("AMD ordering of the net: {}", e.plain()))?;
     fwd.extend(n_p..n);
     inv.extend(n_p..n);
     Ok(faer::perm::Perm::new_checked(

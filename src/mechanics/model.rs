@@ -31,6 +31,22 @@ pub enum MechanicsError {
         /// Where it was detected.
         detail: String,
     },
+    /// Numbers beyond double precision: a modulus, a section or a load so
+    /// large that the stiffness or the forces overflow.
+    #[error(
+        "the frame's numbers overflow double precision ({detail}): check the moduli, \
+         sections and loads"
+    )]
+    NotFinite {
+        /// Where it was detected.
+        detail: String,
+    },
+    /// The stiffness could not be factored in the memory there is.
+    #[error("out of memory factoring the frame's stiffness ({detail})")]
+    OutOfMemory {
+        /// Where it was detected.
+        detail: String,
+    },
 }
 
 impl MechanicsError {

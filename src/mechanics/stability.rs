@@ -77,11 +77,7 @@ pub(super) fn stability(
 ) -> Result<Stability, MechanicsError> {
     let system = solver.system();
     let ev = system.evaluate(solver.model(), state, lambda);
-    let lu = system
-        .factor(&ev.values)
-        .map_err(|e| MechanicsError::Mechanism {
-            detail: e.to_string(),
-        })?;
+    let lu = system.factor(&ev.values)?;
     let w = solver.weights();
     let n_free = system.n_free;
     // A start with every component: a fixed pseudo-random sequence.

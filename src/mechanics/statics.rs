@@ -58,12 +58,12 @@ impl StaticSolver {
     pub fn linear_response(&self) -> Result<State, MechanicsError> {
         let mut state = self.reference_state();
         let ev = self.system().evaluate(self.model(), &state, 1.0);
-        let lu = self
-            .system()
-            .factor(&ev.values)
-            .map_err(|e| MechanicsError::Mechanism {
-                detail: e.to_string(),
-            })?;
+        let lu = self.system().factor(&ev.values)?;
+        if let Some(i) = ev.residual.iter().position(|r| !r.is_finite()) {
+            return Err(MechanicsError::NotFinite {
+                detail: format!("the load or residual of unknown {i} is not finite"),
+            });
+        }
         let mut rhs = self.system().column(&ev.residual);
         System::solve_in_place(&lu, rhs.as_mut());
         let delta: Vec<f64> = (0..self.system().n_rows).map(|i| -rhs[(i, 0)]).collect();

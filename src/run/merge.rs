@@ -44,24 +44,27 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOu
     }
     let mut tables = Vec::new();
     for m in &merged {
-        let bad = |reason: String| ShardError::Format {
-            path: m.files[0].clone(),
+        // A bad row is its own shard's fault.
+        let bad = |row: usize, reason: String| ShardError::Format {
+            path: m.files[m.origins.get(row).copied().unwrap_or(0)].clone(),
             reason,
         };
         let table = match m.header.command.as_str() {
             "front" => Table::Front(
                 m.rows
                     .iter()
-                    .map(|l| parse_front_row(l).map_err(|e| bad(e.to_string())))
+                    .enumerate()
+                    .map(|(r, l)| parse_front_row(l).map_err(|e| bad(r, e.to_string())))
                     .collect::<Result<_, _>>()?,
             ),
             "study" => Table::Study(
                 m.rows
                     .iter()
-                    .map(|l| parse_study_row(l).map_err(|e| bad(e.to_string())))
+                    .enumerate()
+                    .map(|(r, l)| parse_study_row(l).map_err(|e| bad(r, e.to_string())))
                     .collect::<Result<_, _>>()?,
             ),
-            other => return Err(bad(format!("unknown command `{other}`")).into()),
+            other => return Err(bad(0, format!("unknown command `{other}`")).into()),
         };
         tables.push(table);
     }

@@ -33,6 +33,10 @@ pub use rod_properties::{RodKind, RodProperties, RodPropertiesError, RodStiffnes
 /// Longest scene name: it names the results folder and files made from it.
 pub const MAX_NAME_LEN: usize = 128;
 
+/// Tallest truss, as a multiple of the aperture diameter (real rings:
+/// 0.1–0.6).
+pub const MAX_HEIGHT_RATIO: f64 = 10.0;
+
 /// A whole reflector scene: the input of one run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -472,6 +476,18 @@ impl Scene {
             ));
         }
         positive("truss.height_m", t.height_m)?;
+        let diameter = self.reflector.aperture_diameter_m;
+        if t.height_m > MAX_HEIGHT_RATIO * diameter {
+            return Err(SceneError::invalid(
+                "truss.height_m",
+                format!(
+                    "{:e} m is more than {MAX_HEIGHT_RATIO} × the aperture ({diameter} m): the \
+                     ties would span decades more than the net's cables, beyond what one \
+                     force density solve balances",
+                    t.height_m
+                ),
+            ));
+        }
         if !(1..=MAX_ELEMENTS_PER_ROD).contains(&t.elements_per_rod) {
             return Err(SceneError::invalid(
                 "truss.elements_per_rod",

@@ -52,8 +52,9 @@ pub enum TrussError {
     },
     /// No equilibrium under the full load: the truss buckles or collapses.
     #[error(
-        "the ring truss found no equilibrium under the net's pull: it {termination}; the loads \
-         exceed what the truss can carry (last converged load factor {load_factor:.4})"
+        "the ring truss found no equilibrium under its loads (the net's pull, or the loads \
+         given): it {termination}; they exceed what the truss can carry (last converged load \
+         factor {load_factor:.4})"
     )]
     NoEquilibrium {
         /// How the static solve ended.

@@ -71,6 +71,14 @@ pub struct SlackNodes {
 
 impl fmt::Display for SlackNodes {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.nodes.is_empty() {
+            return write!(
+                f,
+                "no strictly positive force densities balance the prescribed geometry within \
+                 the bounds, though no node's cables need be slack: the bound [q] \
+                 (cables.max_force_density_n_per_m) or the tension floor is too tight"
+            );
+        }
         let nodes: Vec<String> = self.nodes.iter().map(usize::to_string).collect();
         write!(
             f,
@@ -288,10 +296,25 @@ impl Design {
             .collect();
         let errors = problem.surface_errors_m(&eq.nodes_xyz_m);
         let surface_max_m = errors.iter().map(|e| e.abs()).fold(0.0, f64::max);
+        let max_residual_n = problem.prescribed_residual_n(&q);
+        // A non-finite number is never a design (the forward solve checked
+        // positions, tensions and reactions).
+        let checks = [
+            ("max_residual_n", max_residual_n),
+            ("surface_max_m", surface_max_m),
+        ];
+        if let Some((what, value)) = checks.into_iter().find(|(_, v)| !v.is_finite()) {
+            return Err(UniformityError::NonFinite {
+                solver: solver.to_string(),
+                what,
+                value,
+                max_q: q.iter().copied().fold(0.0, f64::max),
+            });
+        }
         Ok(Design {
             solver: solver.to_string(),
             ratio: sets.iter().map(|s| s.ratio).fold(0.0, f64::max),
-            max_residual_n: problem.prescribed_residual_n(&q),
+            max_residual_n,
             max_tension_n: eq.max_force_n(),
             surface_rms_m: problem.surface_rms_m(&eq.nodes_xyz_m),
             surface_max_m,

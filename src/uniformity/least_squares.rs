@@ -82,6 +82,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
 use super::{Design, KnobRange, Termination, UniformityError, UniformityProblem, UniformitySolver};
+use crate::algebra::Plain;
 
 const SOLVER: &str = "least-squares";
 
@@ -462,10 +463,10 @@ impl Kkt {
             status: format!("{what} Cholesky factorisation of the Schur complement: {e}"),
         };
         let symbolic = SymbolicLlt::try_new(s.symbolic(), Side::Lower)
-            .map_err(|e| failed("symbolic", format!("{e:?}")))?;
+            .map_err(|e| failed("symbolic", e.plain()))?;
         Llt::try_new_with_symbolic(symbolic, s.as_ref(), Side::Lower)
             .map(Some)
-            .map_err(|e| failed("numeric", format!("{e:?}")))
+            .map_err(|e| failed("numeric", e.plain()))
     }
 
     /// Iterative refinement of `(T, μ)` against the unshifted system, with the

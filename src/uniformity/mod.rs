@@ -97,6 +97,21 @@ pub enum UniformityError {
         /// The inner solver's status.
         status: String,
     },
+    /// A design whose numbers are not finite.
+    #[error(
+        "the `{solver}` design's {what} is {value}: force densities up to {max_q:e} N/m \
+         overflow double precision on this geometry"
+    )]
+    NonFinite {
+        /// The solver.
+        solver: String,
+        /// The quantity.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+        /// The largest force density.
+        max_q: f64,
+    },
     /// A forward solve failed.
     #[error(transparent)]
     Fdm(#[from] FdmError),
@@ -119,7 +134,7 @@ impl UniformityError {
             | UniformityError::Unsupported { .. }
             | UniformityError::RatioLimit { .. }
             | UniformityError::Infeasible { .. } => true,
-            UniformityError::SolverFailed { .. } => false,
+            UniformityError::SolverFailed { .. } | UniformityError::NonFinite { .. } => false,
             UniformityError::Fdm(e) => e.is_bad_input(),
         }
     }

@@ -118,6 +118,16 @@ impl UniformityProblem {
                 "zero length in the prescribed geometry",
             ));
         }
+        let every: Vec<usize> = (0..network.n_nodes()).collect();
+        if let Some((a, b)) = crate::network::coincident_nodes(&network.nodes, &every) {
+            return Err(UniformityError::invalid(
+                format!("nodes {a} and {b}"),
+                format!(
+                    "both at {:?} m in the prescribed geometry",
+                    network.nodes[a]
+                ),
+            ));
+        }
         if let Some(&i) = surface_nodes
             .iter()
             .find(|&&i| structure.free_index(i).is_none())
