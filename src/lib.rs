@@ -29,7 +29,9 @@
 //! * [`report`] — files a run writes (atomically): JSON, CSV, VTK, plots;
 //! * [`study`] — what accuracy costs in time: one knob at a time against a
 //!   converged reference;
-//! * [`shard`] — sweeps split across machines and merged back.
+//! * [`shard`] — sweeps split across machines and merged back;
+//! * [`resources`] — the memory a run will take, checked before it starts;
+//! * [`input`] — input files read with a size cap.
 #![warn(missing_docs)]
 
 pub mod algebra;
@@ -38,9 +40,11 @@ pub mod effects;
 pub mod fdm;
 pub mod frame;
 pub mod geometry;
+pub mod input;
 pub mod mechanics;
 pub mod network;
 pub mod report;
+pub mod resources;
 pub mod run;
 pub mod scene;
 pub mod shard;
@@ -93,6 +97,9 @@ pub enum Error {
     /// A bad shard, or shards that cannot be merged.
     #[error(transparent)]
     Shard(#[from] shard::ShardError),
+    /// A workload beyond the memory limit.
+    #[error(transparent)]
+    Memory(#[from] resources::MemoryError),
 }
 
 impl Error {
@@ -100,7 +107,7 @@ impl Error {
     /// internal failures (exit code 1).
     pub fn is_bad_input(&self) -> bool {
         match self {
-            Error::Scene(_) | Error::Network(_) => true,
+            Error::Scene(_) | Error::Network(_) | Error::Memory(_) => true,
             Error::Fdm(e) => e.is_bad_input(),
             Error::Uniformity(e) => e.is_bad_input(),
             Error::Report(e) => e.is_bad_input(),

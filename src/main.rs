@@ -30,6 +30,36 @@ macro_rules! say {
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Most memory a run may take, e.g. `8G`, `512M` (default: the memory
+    /// the machine has available). A run whose estimated need is larger is
+    /// refused before it computes, naming the input that sets its size.
+    #[arg(long, global = true, value_parser = parse_bytes)]
+    max_memory: Option<u64>,
+}
+
+/// `8G`, `512M`, `64K` or a number of bytes.
+fn parse_bytes(text: &str) -> Result<u64, String> {
+    let text = text.trim();
+    let (number, unit) = match text.char_indices().find(|(_, c)| c.is_ascii_alphabetic()) {
+        Some((i, _)) => (&text[..i], text[i..].to_ascii_uppercase()),
+        None => (text, String::new()),
+    };
+    let scale: u64 = match unit.trim_end_matches("IB").trim_end_matches('B') {
+        "" => 1,
+        "K" => 1 << 10,
+        "M" => 1 << 20,
+        "G" => 1 << 30,
+        "T" => 1 << 40,
+        _ => return Err(format!("unknown unit in {text:?}: use K, M, G or T")),
+    };
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("{text:?} is not a size such as 8G or 512M"))?;
+    if !(value.is_finite() && value > 0.0) {
+        return Err(format!("{text:?} must be a positive size"));
+    }
+    Ok((value * scale as f64).min(u64::MAX as f64) as u64)
 }
 
 #[derive(Subcommand)]
@@ -385,6 +415,7 @@ fn bar() -> Bar {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    ringmesh::resources::set_memory_limit(cli.max_memory);
     // SIGINT, SIGTERM, SIGHUP: no staging folder or temporary file is left.
     let _ = ctrlc::set_handler(|| ringmesh::report::abandon_all_and_exit(130));
     let result = match &cli.command {

@@ -274,7 +274,7 @@ impl Network {
     /// Reads and validates a network in the interchange format.
     pub fn read_json(path: &Path) -> Result<Network, NetworkError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| NetworkError::Io {
+        let text = crate::input::read_input(path).map_err(|source| NetworkError::Io {
             path: shown.clone(),
             source,
         })?;

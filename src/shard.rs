@@ -263,7 +263,7 @@ pub fn shard_csv(header: &ShardHeader, columns: &str, rows: &[(usize, String)]) 
 /// I/O, or a file without the shard header, the `point` column or valid
 /// point indices.
 pub fn read_shard(path: &Path) -> Result<ShardFile, ShardError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ShardError::Io {
+    let text = crate::input::read_input(path).map_err(|source| ShardError::Io {
         path: path.to_path_buf(),
         source,
     })?;

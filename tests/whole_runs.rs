@@ -300,3 +300,68 @@ fn an_unwritable_folder_is_refused_before_computing() {
     assert_eq!(o.status.code(), Some(2), "{why}");
     assert!(why.contains("name") && why.contains("at most 128"), "{why}");
 }
+
+/// A workload beyond the memory limit is refused before anything is computed
+/// or written (exit 2), naming the input that sets its size and the estimate
+/// (`rings = 815` took 3.5 GB in `mesh` and aborted `optimize`; `front
+/// --points 1e9` aborted allocating 8 GB); an input file larger than any
+/// input can be is refused without reading it all (`mesh /dev/zero` read 4 GB).
+#[test]
+fn a_run_beyond_the_memory_limit_is_refused_before_computing() {
+    let (_root, scene, out) = scratch();
+    let refused = |args: &[&str], needles: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+            .args(args)
+            .output()
+            .unwrap();
+        let why = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {why}");
+        for needle in needles {
+            assert!(why.contains(needle), "{args:?}: {why}");
+        }
+        assert!(!out.exists(), "{args:?} wrote");
+    };
+    let scene = scene.to_str().unwrap();
+    let out_arg = out.to_str().unwrap();
+    refused(
+        &["design", scene, "-o", out_arg, "--max-memory", "50M"],
+        &["front_net.rings = 3", "allowed by --max-memory"],
+    );
+    refused(
+        &["front", scene, "--points", "1000000000", "-o", out_arg],
+        &["--points 1000000000", "GB"],
+    );
+    refused(
+        &["mesh", "/dev/zero", "-o", out_arg],
+        &["/dev/zero", "larger than 256 MiB"],
+    );
+    refused(
+        &["design", scene, "-o", out_arg, "--max-memory", "lots"],
+        &["--max-memory"],
+    );
+}
+
+/// A result that is not finite is an error (exit 1) naming where, never a
+/// success: a 1e200 moment on the cantilever gave "converged at the full
+/// load" with infinite positions.
+#[test]
+fn a_frame_whose_solution_overflows_is_an_error() {
+    let root = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
+        .unwrap()
+        .replace(
+            "moment_nm = [0.0, 0.0, 62.83185307179586]",
+            "moment_nm = [0.0, 0.0, 1e200]",
+        );
+    let path = root.path().join("frame.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = root.path().join("frame.json");
+    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let why = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{why}");
+    assert!(why.contains("not finite"), "{why}");
+    assert!(!out.exists());
+}

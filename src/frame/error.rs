@@ -45,9 +45,15 @@ impl FrameFileError {
         }
     }
 
-    /// Every frame-file error is the input's fault (exit code 2).
+    /// A frame-file error is the input's fault (exit code 2), but for numbers
+    /// that overflow while solving and memory that runs out (exit code 1).
     pub fn is_bad_input(&self) -> bool {
-        true
+        !matches!(
+            self,
+            FrameFileError::Model(
+                MechanicsError::NotFinite { .. } | MechanicsError::OutOfMemory { .. }
+            )
+        )
     }
 
     pub(super) fn invalid(key: impl Into<String>, reason: impl Into<String>) -> Self {

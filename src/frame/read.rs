@@ -16,7 +16,7 @@ impl FrameFile {
     /// (the key is named).
     pub fn read(path: &Path) -> Result<FrameFile, FrameFileError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| FrameFileError::Io {
+        let text = crate::input::read_input(path).map_err(|source| FrameFileError::Io {
             path: shown.clone(),
             source,
         })?;

@@ -12,6 +12,7 @@ use crate::report::{
     assembly_vtu, cables_csv, convergence_csv, convergence_plot, surface_plot, write_atomic,
     write_json, NodePanel, OutputSet, SurfaceFigure, WithRun,
 };
+use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
 use crate::verify::Verification;
 use crate::Error;
@@ -46,6 +47,7 @@ pub fn design(
     let scene = Scene::read(scene_path)?;
     let read_s = clock.elapsed().as_secs_f64();
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    check_scene(&scene, SceneCommand::Design, 1)?;
     let set = OutputSet::begin(&dir, &FILES)?;
     let mut run = crate::design::run(&scene, settings, observe)?;
     run.report.timings.read_s = read_s;

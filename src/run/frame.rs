@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use crate::algebra::norm3;
 use crate::frame::{FrameFile, FrameFileError, NodeOrigin};
-use crate::mechanics::{rotation, StaticSolver, StaticTermination, StepRecord};
+use crate::mechanics::{rotation, MechanicsError, StaticSolver, StaticTermination, StepRecord};
 use crate::report::write_json;
 use crate::Error;
 
@@ -120,6 +120,11 @@ pub fn frame(
         bodies: file.bodies.len(),
         joints: file.model.joint_count(),
     };
+    crate::resources::check_memory(
+        &format!("the frame's {} elements", counts.elements),
+        "the factorised stiffness",
+        crate::resources::frame_memory(counts.elements as u64),
+    )?;
     let solver = StaticSolver::new(file.model.clone()).map_err(FrameFileError::from)?;
     let solution = solver.solve(&file.settings).map_err(FrameFileError::from)?;
     let reference = file.model.reference();
@@ -164,6 +169,20 @@ pub fn frame(
             }
         })
         .collect();
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    let bad_node = nodes
+        .iter()
+        .find(|n| !finite(&n.position_m) || !finite(&n.rotation_rad));
+    let bad_reaction = solution.reactions.iter().position(|r| !finite(r));
+    if let Some(what) = bad_node
+        .map(|n| format!("position of node {}", n.id))
+        .or(bad_reaction.map(|n| format!("reaction at node {n}")))
+    {
+        return Err(FrameFileError::from(MechanicsError::NotFinite {
+            detail: format!("the solved {what} is not finite"),
+        })
+        .into());
+    }
     let output = FrameOutput {
         file: frame_path.display().to_string(),
         termination: solution.termination,

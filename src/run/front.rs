@@ -8,6 +8,7 @@ use crate::design::scene_problem;
 use crate::report::{
     front_csv, front_plot, front_row, write_atomic, FrontRow, OutputSet, FRONT_COLUMNS,
 };
+use crate::resources::{check_memory, check_scene, SceneCommand};
 use crate::scene::Scene;
 use crate::shard::Shard;
 use crate::study;
@@ -30,6 +31,18 @@ pub fn front(
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     // A shard writes one file under the folder's lock once computed; the
     // whole front takes the folder before computing.
+    check_scene(
+        &scene,
+        SceneCommand::Optimize,
+        rayon::current_num_threads() as u64,
+    )?;
+    // Each point's job, result and row: a few hundred bytes.
+    let rows = (points as u64).saturating_mul(solvers.len().max(1) as u64);
+    check_memory(
+        &format!("--points {points}"),
+        &format!("{rows} points' jobs, results and rows"),
+        rows.saturating_mul(BYTES_PER_POINT),
+    )?;
     let set = match shard {
         Some(_) => None,
         None => Some(OutputSet::begin(&dir, &FILES)?),
@@ -83,6 +96,10 @@ pub fn front(
     let paths = write_front(set, &scene.name, &rows, Some(&failed), &front_csv(&rows))?;
     Ok((front, paths))
 }
+
+/// Memory of one point of a front beside the solves: its job, its result,
+/// its row of text.
+const BYTES_PER_POINT: u64 = 512;
 
 /// The files of a whole front.
 pub(crate) const FILES: [&str; 3] = ["front.csv", "front.png", "front.svg"];

@@ -6,6 +6,7 @@ use super::default_output_dir;
 use crate::geometry::build_mesh;
 use crate::network::NetworkSummary;
 use crate::report::{network_vtu, write_atomic, write_json, OutputSet};
+use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
 use crate::Error;
 
@@ -25,6 +26,7 @@ pub struct MeshOutcome {
 pub fn mesh(scene_path: &Path, output_dir: Option<&Path>) -> Result<MeshOutcome, Error> {
     let scene = Scene::read(scene_path)?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    check_scene(&scene, SceneCommand::Mesh, 1)?;
     let set = OutputSet::begin(&dir, &["network.json", "mesh.vtu"])?;
     let mesh = build_mesh(&scene)?;
     let summary = mesh.network.summary();

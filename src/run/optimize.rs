@@ -8,6 +8,7 @@ use serde::Serialize;
 use super::default_output_dir;
 use crate::design::{default_solver, scene_problem};
 use crate::report::{cables_csv, write_atomic, write_json, OutputSet, WithRun};
+use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
 use crate::uniformity::{Design, SolverKind};
 use crate::Error;
@@ -30,6 +31,7 @@ pub fn optimize(
 ) -> Result<(Design, Vec<PathBuf>), Error> {
     let scene = Scene::read(scene_path)?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
+    check_scene(&scene, SceneCommand::Optimize, 1)?;
     let set = OutputSet::begin(&dir, &["design.json", "cables.csv"])?;
     let (mesh, problem) = scene_problem(&scene)?;
     let solver = solver.unwrap_or_else(|| default_solver(&scene));

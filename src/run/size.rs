@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use super::default_output_dir;
 use crate::design::DesignSettings;
 use crate::report::{sizing_csv, write_atomic, OutputSet};
+use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
 use crate::sizing::{catalogue, size_truss, SectionTrial, Sections, Sizing};
 use crate::Error;
@@ -47,6 +48,7 @@ pub fn size(
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     let sized_name = format!("{}-sized", scene.name);
     let toml_name = format!("{sized_name}.toml");
+    check_scene(&scene, SceneCommand::Design, 1)?;
     let set = OutputSet::begin(&dir, &["sizing.csv", &toml_name])?;
     let mut sizing = size_truss(&scene, &sections, margin, settings, observe)?;
     sizing.scene.name = sized_name;

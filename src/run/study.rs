@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use super::{default_output_dir, write_shard, Progress};
 use crate::report::{study_csv, study_plot, study_row, write_atomic, OutputSet, STUDY_COLUMNS};
+use crate::resources::{check_scene, SceneCommand};
 use crate::scene::{Scene, TrussModel};
 use crate::shard::Shard;
 use crate::study::{self, Knob, StudyRow, StudySettings};
@@ -107,6 +108,7 @@ pub fn study(
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     // A shard writes one file under the folder's lock once computed; the
     // whole study takes the folder before computing.
+    check_scene(&scene, SceneCommand::Design, options.jobs.max(1) as u64)?;
     let set = match shard {
         Some(_) => None,
         None => Some(OutputSet::begin(&dir, &FILES)?),

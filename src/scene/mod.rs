@@ -364,7 +364,7 @@ impl Scene {
     /// relative to the scene file's folder.
     pub fn read(path: &Path) -> Result<Scene, SceneError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        let text = crate::input::read_input(path).map_err(|source| SceneError::Io {
             path: shown.clone(),
             source,
         })?;

@@ -294,7 +294,7 @@ impl RodProperties {
     /// The file cannot be read, or its content is invalid (see [`Self::parse`]).
     pub fn read(path: &Path, bays: usize) -> Result<Self, RodPropertiesError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| RodPropertiesError::Io {
+        let text = crate::input::read_input(path).map_err(|source| RodPropertiesError::Io {
             path: shown.clone(),
             source,
         })?;

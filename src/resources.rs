@@ -1,0 +1,202 @@
+//! The memory a run will take, checked before it starts: a command's
+//! workload estimated from the sizes its inputs ask for, against a limit
+//! (the input files' own size cap is [`crate::input`]'s).
+//!
+//! The estimates are linear fits, rounded up, of the peak resident memory
+//! measured on this project's scenes (2-core machine, release build):
+//!
+//! | command | measured | estimate |
+//! |---|---|---|
+//! | `mesh` | 13 / 34 / 125 MB at 7.6k / 29k / 115k nodes | 16 MB + 1.2 kB/node |
+//! | `optimize` | 32 / 101 / 392 MB at the same sizes | 32 MB + 3.6 kB/node |
+//! | `design` | 197 / 610 MB at 7.6k / 29k nodes | 100 MB + 21 kB/node |
+//! | `frame` | 134 MB / 1.14 GB at 1e4 / 1e5 elements | 20 MB + 12 kB/element |
+//!
+//! (super-60m with 14, 28 and 56 rings; the cantilever benchmark with 1e4 and
+//! 1e5 elements). Commands that run several designs at once (`front`,
+//! `study`) multiply by the worker threads.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::scene::Scene;
+
+/// The memory limit, bytes; 0: the machine's available memory.
+static LIMIT: AtomicU64 = AtomicU64::new(0);
+
+/// A workload that would not fit.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{key} asks for about {} of memory ({what}), more than the {} {}: \
+     nothing was computed; lower it, or raise the limit with --max-memory",
+    bytes_text(*.estimate),
+    bytes_text(*.limit),
+    if *.machine { "this machine has available" } else { "allowed by --max-memory" }
+)]
+pub struct MemoryError {
+    /// The input that sets the size (`front_net.rings`, `--points`, …).
+    pub key: String,
+    /// What the estimate covers.
+    pub what: String,
+    /// The estimate, bytes.
+    pub estimate: u64,
+    /// The limit, bytes.
+    pub limit: u64,
+    /// The limit is the machine's available memory (no `--max-memory`).
+    pub machine: bool,
+}
+
+/// `bytes` for a reader: `3.5 GB`, `120 MB`.
+fn bytes_text(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else {
+        format!("{:.0} MB", (b / 1e6).max(1.0))
+    }
+}
+
+/// Sets the memory limit (`None`: the machine's available memory).
+pub fn set_memory_limit(bytes: Option<u64>) {
+    LIMIT.store(bytes.unwrap_or(0), Ordering::Relaxed);
+}
+
+/// The machine's available memory (`MemAvailable` of `/proc/meminfo`), bytes.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Refuses a workload of `estimate` bytes set by `key` beyond the limit.
+///
+/// # Errors
+/// [`MemoryError`] naming `key`, the estimate and the limit.
+pub fn check_memory(key: &str, what: &str, estimate: u64) -> Result<(), MemoryError> {
+    let set = LIMIT.load(Ordering::Relaxed);
+    let (limit, machine) = match set {
+        0 => match available_memory() {
+            Some(available) => (available, true),
+            None => return Ok(()),
+        },
+        set => (set, false),
+    };
+    if estimate > limit {
+        return Err(MemoryError {
+            key: key.to_string(),
+            what: what.to_string(),
+            estimate,
+            limit,
+            machine,
+        });
+    }
+    Ok(())
+}
+
+/// Nodes of a scene's network (front, rear; the ties add none), before it
+/// is built.
+pub fn scene_nodes(scene: &Scene) -> u64 {
+    let (bays, rings) = (scene.truss.bays as u64, scene.front_net.rings as u64);
+    2 * (1 + bays.saturating_mul(rings).saturating_mul(rings + 1) / 2)
+}
+
+/// Memory of one command's workload on `scene`, bytes (see the module
+/// documentation).
+pub fn scene_memory(scene: &Scene, command: SceneCommand) -> u64 {
+    let nodes = scene_nodes(scene);
+    let (base, per_node) = match command {
+        SceneCommand::Mesh => (16 << 20, 1_200),
+        SceneCommand::Optimize => (32 << 20, 3_600),
+        SceneCommand::Design => (100 << 20, 21_000),
+    };
+    base + nodes.saturating_mul(per_node)
+}
+
+/// The workloads [`scene_memory`] estimates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SceneCommand {
+    /// Building and writing the network.
+    Mesh,
+    /// One uniformity solve.
+    Optimize,
+    /// The outer loop, its verification and limit search.
+    Design,
+}
+
+/// Checks `command`'s workload on `scene`, naming `front_net.rings`.
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_scene(scene: &Scene, command: SceneCommand, parallel: u64) -> Result<(), MemoryError> {
+    let what = format!(
+        "{} nodes{}",
+        scene_nodes(scene),
+        if parallel > 1 {
+            format!(", {parallel} designs at once")
+        } else {
+            String::new()
+        }
+    );
+    let key = format!(
+        "front_net.rings = {} with truss.bays = {}",
+        scene.front_net.rings, scene.truss.bays
+    );
+    check_memory(
+        &key,
+        &what,
+        scene_memory(scene, command).saturating_mul(parallel.max(1)),
+    )
+}
+
+/// Memory of a frame of `elements` elements, bytes.
+pub fn frame_memory(elements: u64) -> u64 {
+    (20 << 20) + elements.saturating_mul(12_000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn estimates_cover_the_measured_peaks() {
+        // super-60m (36 bays) at 14 / 28 / 56 rings: measured peaks, bytes.
+        let mut scene = Scene::read(std::path::Path::new("problems/super-60m.toml")).unwrap();
+        let measured = [
+            (14, 13_312e3, 31_848e3, Some(196_888e3)),
+            (28, 34_008e3, 100_808e3, Some(610_452e3)),
+            (56, 124_672e3, 392_352e3, None),
+        ];
+        for (rings, mesh, optimize, design) in measured {
+            scene.front_net.rings = rings;
+            for (command, peak) in [
+                (SceneCommand::Mesh, Some(mesh)),
+                (SceneCommand::Optimize, Some(optimize)),
+                (SceneCommand::Design, design),
+            ] {
+                let Some(peak) = peak else { continue };
+                let estimate = scene_memory(&scene, command) as f64;
+                assert!(
+                    (1.0..2.0).contains(&(estimate / peak)),
+                    "{rings} rings, {command:?}: {estimate:e} for {peak:e}"
+                );
+            }
+        }
+        for (elements, peak) in [(1e4, 134_052e3), (1e5, 1_141_656e3)] {
+            let estimate = frame_memory(elements as u64) as f64;
+            assert!((1.0..2.0).contains(&(estimate / peak)), "{elements}");
+        }
+    }
+
+    #[test]
+    fn a_workload_beyond_the_limit_is_refused_naming_its_key() {
+        set_memory_limit(Some(1 << 30));
+        let e = check_memory("front_net.rings = 815", "4 M nodes", 3 << 30).unwrap_err();
+        set_memory_limit(None);
+        let text = e.to_string();
+        assert!(
+            text.contains("front_net.rings = 815") && text.contains("3.2 GB"),
+            "{text}"
+        );
+        assert!(text.contains("--max-memory"), "{text}");
+    }
+}
