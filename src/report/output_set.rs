@@ -124,18 +124,14 @@ impl OutputSet {
     /// # Errors
     /// [`ReportError::Name`] for a name that is not a plain file name,
     /// [`ReportError::Busy`] when another run holds the folder,
-    /// [`ReportError::Io`] when the folder or the staging folder beside it
-    /// cannot be created.
+    /// [`ReportError::Unwritable`] when the folder or the staging folder
+    /// beside it cannot be created.
     pub fn begin(dir: &Path, names: &[&str]) -> Result<OutputSet, ReportError> {
         for name in names {
             check_name(name)?;
         }
-        let unwritable = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| ReportError::Unwritable { path, source }
-        };
-        fs::create_dir_all(dir).map_err(unwritable(dir))?;
-        let target = fs::canonicalize(dir).map_err(unwritable(dir))?;
+        fs::create_dir_all(dir).map_err(unwritable_at(dir))?;
+        let target = fs::canonicalize(dir).map_err(unwritable_at(dir))?;
         let (Some(parent), Some(folder)) = (target.parent(), target.file_name()) else {
             return Err(ReportError::Unwritable {
                 path: target.clone(),
@@ -145,7 +141,7 @@ impl OutputSet {
                 ),
             });
         };
-        let lock = lock_folder(&target)?;
+        let lock = lock_folder(&target, Wait::No)?;
         let prefix = format!(".{}.staging-", folder.to_string_lossy());
         if let Ok(entries) = fs::read_dir(parent) {
             for entry in entries.flatten() {
@@ -157,12 +153,9 @@ impl OutputSet {
         let run_id = new_run_id();
         let staging = parent.join(format!("{prefix}{run_id}"));
         register(&staging);
-        if let Err(source) = fs::create_dir(&staging) {
+        if let Err(e) = fs::create_dir(&staging) {
             unregister(&staging);
-            return Err(ReportError::Unwritable {
-                path: staging,
-                source,
-            });
+            return Err(unwritable_at(&staging)(e));
         }
         Ok(OutputSet {
             target,
@@ -195,25 +188,12 @@ impl OutputSet {
     /// # Errors
     /// A bad name, a folder that cannot be created, or the write failed.
     pub fn write_one(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, ReportError> {
-        use std::os::unix::fs::MetadataExt;
         check_name(name)?;
-        let unwritable = |source| ReportError::Unwritable {
-            path: dir.to_path_buf(),
-            source,
-        };
-        fs::create_dir_all(dir).map_err(unwritable)?;
-        loop {
-            let folder = File::open(dir).map_err(unwritable)?;
-            rustix::fs::flock(&folder, FlockOperation::LockExclusive)
-                .map_err(|e| unwritable(e.into()))?;
-            let held = folder.metadata().map_err(unwritable)?;
-            let now = fs::metadata(dir).map_err(unwritable)?;
-            if (held.dev(), held.ino()) == (now.dev(), now.ino()) {
-                let path = dir.join(name);
-                super::write_atomic(&path, bytes)?;
-                return Ok(path);
-            }
-        }
+        fs::create_dir_all(dir).map_err(unwritable_at(dir))?;
+        let _lock = lock_folder(dir, Wait::Yes)?;
+        let path = dir.join(name);
+        super::write_atomic(&path, bytes)?;
+        Ok(path)
     }
 
     /// Where to write the set's file `name` (in the staging folder).
@@ -253,17 +233,11 @@ impl OutputSet {
             let path = self.staging.join(name);
             let stamped = match path.extension().and_then(|e| e.to_str()) {
                 Some("svg" | "vtu") => {
-                    let text = fs::read_to_string(&path).map_err(|source| ReportError::Io {
-                        path: path.clone(),
-                        source,
-                    })?;
+                    let text = fs::read_to_string(&path).map_err(at(&path))?;
                     xml_with_comment(&text, &note).into_bytes()
                 }
                 Some("png") => {
-                    let bytes = fs::read(&path).map_err(|source| ReportError::Io {
-                        path: path.clone(),
-                        source,
-                    })?;
+                    let bytes = fs::read(&path).map_err(at(&path))?;
                     match png_with_text(&bytes, "ringmesh-run", &self.run_id) {
                         Some(bytes) => bytes,
                         None => continue,
@@ -289,7 +263,7 @@ impl OutputSet {
             if !path.is_file() {
                 continue;
             }
-            let bytes = fs::read(&path).map_err(|source| ReportError::Io { path, source })?;
+            let bytes = fs::read(&path).map_err(at(&path))?;
             files.push(FileRecord {
                 name: name.clone(),
                 bytes: bytes.len(),
@@ -318,12 +292,8 @@ impl OutputSet {
                 });
             }
         }
-        let io = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| ReportError::Io { path, source }
-        };
-        for entry in fs::read_dir(&self.target).map_err(io(&self.target))? {
-            let entry = entry.map_err(io(&self.target))?;
+        for entry in fs::read_dir(&self.target).map_err(at(&self.target))? {
+            let entry = entry.map_err(at(&self.target))?;
             let name = entry.file_name();
             if self.names.iter().any(|n| name == n.as_str()) {
                 continue;
@@ -331,12 +301,12 @@ impl OutputSet {
             link_tree(&entry.path(), &self.staging.join(&name))?;
         }
         let permissions = fs::metadata(&self.target)
-            .map_err(io(&self.target))?
+            .map_err(at(&self.target))?
             .permissions();
-        fs::set_permissions(&self.staging, permissions).map_err(io(&self.staging))?;
+        fs::set_permissions(&self.staging, permissions).map_err(at(&self.staging))?;
         // Held across the swap: a signal handler waits for it to finish.
         let pending = lock_pending();
-        exchange(&self.staging, &self.target).map_err(io(&self.target))?;
+        exchange(&self.staging, &self.target).map_err(at(&self.target))?;
         self.committed = true;
         drop(pending);
         // The staging path now holds the previous set.
@@ -454,6 +424,18 @@ fn crc32(bytes: &[u8]) -> u32 {
     !crc
 }
 
+/// The [`ReportError::Io`] of a file system call on `path`.
+fn at(path: &Path) -> impl FnOnce(io::Error) -> ReportError {
+    let path = path.to_path_buf();
+    move |source| ReportError::Io { path, source }
+}
+
+/// The [`ReportError::Unwritable`] of a call that prepares the folder `path`.
+fn unwritable_at(path: &Path) -> impl FnOnce(io::Error) -> ReportError {
+    let path = path.to_path_buf();
+    move |source| ReportError::Unwritable { path, source }
+}
+
 /// A plain file name: not empty, no separator, not `.`/`..`, not hidden,
 /// at most [`NAME_MAX`] bytes.
 fn check_name(name: &str) -> Result<(), ReportError> {
@@ -477,17 +459,26 @@ fn check_name(name: &str) -> Result<(), ReportError> {
     }
 }
 
-/// Takes the advisory lock of the folder `target`, refusing if another
-/// run holds it; retries when the folder was swapped away meanwhile.
-fn lock_folder(target: &Path) -> Result<File, ReportError> {
+/// Whether [`lock_folder`] waits for a run that holds the lock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Wait {
+    Yes,
+    No,
+}
+
+/// Takes the advisory lock of the folder `target` — waiting for another
+/// run that holds it, or refusing ([`ReportError::Busy`]) — and retries when
+/// the folder was swapped away meanwhile.
+fn lock_folder(target: &Path, wait: Wait) -> Result<File, ReportError> {
     use std::os::unix::fs::MetadataExt;
-    let io = |source| ReportError::Unwritable {
-        path: target.to_path_buf(),
-        source,
+    let io = |e: io::Error| unwritable_at(target)(e);
+    let operation = match wait {
+        Wait::Yes => FlockOperation::LockExclusive,
+        Wait::No => FlockOperation::NonBlockingLockExclusive,
     };
     loop {
         let folder = File::open(target).map_err(io)?;
-        match rustix::fs::flock(&folder, FlockOperation::NonBlockingLockExclusive) {
+        match rustix::fs::flock(&folder, operation) {
             Ok(()) => {}
             Err(rustix::io::Errno::WOULDBLOCK) => {
                 return Err(ReportError::Busy {
@@ -507,22 +498,18 @@ fn lock_folder(target: &Path) -> Result<File, ReportError> {
 /// Hard-links the file or folder tree `from` to `to` (copies where the file
 /// system has no hard links); symbolic links are recreated.
 fn link_tree(from: &Path, to: &Path) -> Result<(), ReportError> {
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| ReportError::Io { path, source }
-    };
-    let kind = fs::symlink_metadata(from).map_err(io(from))?.file_type();
+    let kind = fs::symlink_metadata(from).map_err(at(from))?.file_type();
     if kind.is_symlink() {
-        let link = fs::read_link(from).map_err(io(from))?;
-        std::os::unix::fs::symlink(link, to).map_err(io(to))?;
+        let link = fs::read_link(from).map_err(at(from))?;
+        std::os::unix::fs::symlink(link, to).map_err(at(to))?;
     } else if kind.is_dir() {
-        fs::create_dir(to).map_err(io(to))?;
-        for entry in fs::read_dir(from).map_err(io(from))? {
-            let entry = entry.map_err(io(from))?;
+        fs::create_dir(to).map_err(at(to))?;
+        for entry in fs::read_dir(from).map_err(at(from))? {
+            let entry = entry.map_err(at(from))?;
             link_tree(&entry.path(), &to.join(entry.file_name()))?;
         }
     } else if fs::hard_link(from, to).is_err() {
-        fs::copy(from, to).map_err(io(to))?;
+        fs::copy(from, to).map_err(at(to))?;
     }
     Ok(())
 }
