@@ -149,6 +149,12 @@ const BAD: &[(&str, &str, &str)] = &[
     ("bays", "2", "truss.bays"),
     ("bays", "1001", "truss.bays"),
     ("height_m", "0.0", "truss.height_m"),
+    // Issue 19: a 1e300 m truss wrote ties with q = 0, a 1e300 Pa modulus
+    // 'converged' in 0 Newton iterations, a 300-character name failed only
+    // when the results folder was made.
+    ("height_m", "1e300", "truss.height_m"),
+    ("youngs_modulus_pa", "1e300", "truss.youngs_modulus_pa"),
+    ("name", "\"xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx\"", "name"),
     (
         "tube_outer_diameter_m",
         "-0.060",

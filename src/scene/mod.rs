@@ -33,6 +33,9 @@ pub use rod_properties::{RodKind, RodProperties, RodPropertiesError, RodStiffnes
 /// Longest scene name: it names the results folder and files made from it.
 pub const MAX_NAME_LEN: usize = 128;
 
+/// Largest elastic modulus a scene may give, Pa (diamond: 1.2e12).
+pub const MAX_MODULUS_PA: f64 = 1e13;
+
 /// Tallest truss, as a multiple of the aperture diameter (real rings:
 /// 0.1–0.6).
 pub const MAX_HEIGHT_RATIO: f64 = 10.0;
@@ -505,8 +508,8 @@ impl Scene {
                 ),
             ));
         }
-        positive("truss.youngs_modulus_pa", t.youngs_modulus_pa)?;
-        positive("truss.shear_modulus_pa", t.shear_modulus_pa)?;
+        modulus("truss.youngs_modulus_pa", t.youngs_modulus_pa)?;
+        modulus("truss.shear_modulus_pa", t.shear_modulus_pa)?;
         positive("truss.density_kg_per_m3", t.density_kg_per_m3)?;
         non_negative("truss.hinge_mass_kg", t.hinge_mass_kg)?;
 
@@ -589,7 +592,7 @@ impl Scene {
 
         let c = &self.cables;
         positive("cables.diameter_m", c.diameter_m)?;
-        positive("cables.youngs_modulus_pa", c.youngs_modulus_pa)?;
+        modulus("cables.youngs_modulus_pa", c.youngs_modulus_pa)?;
         positive("cables.density_kg_per_m3", c.density_kg_per_m3)?;
         positive(
             "cables.max_force_density_n_per_m",
@@ -715,6 +718,19 @@ fn one_tension_of(
 
 /// Largest number of bays a scene may ask for.
 pub const MAX_BAYS: usize = 1_000;
+
+/// An elastic modulus: positive, and at most [`MAX_MODULUS_PA`] (stiffer than
+/// any material; 1e300 made the truss's Newton 'converge' in 0 iterations).
+fn modulus(key: &'static str, value: f64) -> Result<(), SceneError> {
+    positive(key, value)?;
+    if value > MAX_MODULUS_PA {
+        return Err(SceneError::invalid(
+            key,
+            format!("{value:e} Pa is stiffer than any material (at most {MAX_MODULUS_PA:e} Pa)"),
+        ));
+    }
+    Ok(())
+}
 
 fn positive(key: &'static str, value: f64) -> Result<(), SceneError> {
     if value.is_finite() && value > 0.0 {
