@@ -343,7 +343,7 @@ fn a_run_beyond_the_memory_limit_is_refused_before_computing() {
 
 /// A result that is not finite is an error (exit 1) naming where, never a
 /// success: a 1e200 moment on the cantilever gave "converged at the full
-/// load" with infinite positions.
+/// load" with infinite positions; a section beyond any is refused (exit 2).
 #[test]
 fn a_frame_whose_solution_overflows_is_an_error() {
     let root = tempfile::tempdir().unwrap();
@@ -363,5 +363,20 @@ fn a_frame_whose_solution_overflows_is_an_error() {
     let why = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{why}");
     assert!(why.contains("not finite"), "{why}");
+    assert!(!out.exists());
+
+    // A section stiffer than any (EA = 1e300: its roundoff ε·EA exceeds any
+    // load) is refused naming it; it 'converged' undeformed.
+    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
+        .unwrap()
+        .replace("axial_n = 1e4", "axial_n = 1e300");
+    std::fs::write(&path, text).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let why = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{why}");
+    assert!(why.contains("rods[0].axial_n"), "{why}");
     assert!(!out.exists());
 }

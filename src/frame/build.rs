@@ -49,6 +49,26 @@ fn positive(key: &str, v: f64) -> Result<(), FrameFileError> {
     }
 }
 
+/// Largest elastic modulus a frame file may give, Pa (diamond: 1.2e12).
+const MAX_MODULUS_PA: f64 = 1e13;
+
+/// Largest section stiffness (EA, GA in N; GJ, EI in N·m²): a 1 m² steel
+/// section has EA = 2e11 N. Beyond it the stiffness's roundoff, `ε·EA`,
+/// exceeds any load (a cantilever with EA = 1e300 'converged' undeformed).
+const MAX_STIFFNESS: f64 = 1e16;
+
+/// A positive value at most `max`.
+fn bounded(key: &str, v: f64, max: f64, what: &str) -> Result<(), FrameFileError> {
+    positive(key, v)?;
+    if v > max {
+        return Err(FrameFileError::invalid(
+            key,
+            format!("{v:e} is stiffer than any {what} (at most {max:e})"),
+        ));
+    }
+    Ok(())
+}
+
 impl RawSection {
     /// The section, `key` naming where it was written (`rods[2]`, `sections.steel`).
     fn resolve(&self, key: &str) -> Result<Section, FrameFileError> {
@@ -85,8 +105,12 @@ impl RawSection {
                         ),
                     ));
                 }
-                positive(&format!("{key}.tube.youngs_modulus_pa"), t.youngs_modulus_pa)?;
-                positive(&format!("{key}.tube.shear_modulus_pa"), t.shear_modulus_pa)?;
+                for (name, v) in [
+                    ("youngs_modulus_pa", t.youngs_modulus_pa),
+                    ("shear_modulus_pa", t.shear_modulus_pa),
+                ] {
+                    bounded(&format!("{key}.tube.{name}"), v, MAX_MODULUS_PA, "material")?;
+                }
                 Ok(Section::tube(
                     t.outer_diameter_m,
                     t.inner_diameter_m,
@@ -105,13 +129,13 @@ impl RawSection {
                 let shear = self.shear_n.ok_or_else(|| missing("shear_n"))?;
                 let torsion = self.torsion_nm2.ok_or_else(|| missing("torsion_nm2"))?;
                 let bending = self.bending_nm2.ok_or_else(|| missing("bending_nm2"))?;
-                positive(&format!("{key}.axial_n"), axial)?;
+                bounded(&format!("{key}.axial_n"), axial, MAX_STIFFNESS, "section")?;
                 for (i, v) in shear.iter().enumerate() {
-                    positive(&format!("{key}.shear_n[{i}]"), *v)?;
+                    bounded(&format!("{key}.shear_n[{i}]"), *v, MAX_STIFFNESS, "section")?;
                 }
-                positive(&format!("{key}.torsion_nm2"), torsion)?;
+                bounded(&format!("{key}.torsion_nm2"), torsion, MAX_STIFFNESS, "section")?;
                 for (i, v) in bending.iter().enumerate() {
-                    positive(&format!("{key}.bending_nm2[{i}]"), *v)?;
+                    bounded(&format!("{key}.bending_nm2[{i}]"), *v, MAX_STIFFNESS, "section")?;
                 }
                 Ok(Section {
                     axial_n: axial,
