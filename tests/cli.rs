@@ -438,3 +438,42 @@ fn cantilever_writes_its_table_where_asked() {
     assert_eq!(printed, written);
     assert_eq!(written["rows"].as_array().unwrap().len(), 7);
 }
+
+/// A pretension level near the top of double precision (issue 19): the
+/// design's numbers stay finite — the residual was written as `null` and
+/// printed `inf`, with termination "converged".
+#[test]
+fn uniformity_at_a_huge_level_writes_finite_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "hex");
+    let mesh = common::ringmesh(&[
+        "mesh",
+        &common::problem_arg("small-hex.toml"),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(mesh.status.success());
+    let json = path(&dir, "u.json");
+    let run = common::ringmesh(&[
+        "uniformity",
+        out.join("network.json").to_str().unwrap(),
+        "--groups",
+        "front",
+        "--mean-tension",
+        "1e300",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let design: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let residual = design["max_residual"].as_f64().expect("a number, not null");
+    let largest = design["tensions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(Value::as_f64)
+        .fold(0.0, f64::max);
+    assert!(largest > 1e299 && largest.is_finite(), "{largest:e}");
+    assert!(residual <= 1e-12 * largest, "{residual:e} of {largest:e}");
+}

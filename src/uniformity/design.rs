@@ -334,3 +334,25 @@ impl Design {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slack_nodes_without_a_node_say_so() {
+        let none = SlackNodes {
+            nodes: vec![],
+            count: 0,
+        }
+        .to_string();
+        assert!(none.contains("no node's cables need be slack"), "{none}");
+        assert!(!none.contains("nodes  "), "{none}");
+        let some = SlackNodes {
+            nodes: vec![3, 7],
+            count: 2,
+        }
+        .to_string();
+        assert!(some.contains("nodes 3, 7 can only be slack"), "{some}");
+    }
+}
