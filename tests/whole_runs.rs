@@ -379,4 +379,20 @@ fn a_frame_whose_solution_overflows_is_an_error() {
     assert_eq!(o.status.code(), Some(2), "{why}");
     assert!(why.contains("rods[0].axial_n"), "{why}");
     assert!(!out.exists());
+
+    // Within the bound, EA = 1e16 N against EI = 100 N·m²: the force floor
+    // of its stiffness (1.4e3 N) exceeds the 62.8 N·m load, and the solve
+    // 'converged' undeformed in 0 iterations; now it is refused, saying so.
+    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
+        .unwrap()
+        .replace("axial_n = 1e4", "axial_n = 1e16");
+    std::fs::write(&path, text).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let why = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{why}");
+    assert!(why.contains("resolve forces only to about"), "{why}");
+    assert!(!out.exists());
 }

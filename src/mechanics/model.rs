@@ -41,6 +41,18 @@ pub enum MechanicsError {
         /// Where it was detected.
         detail: String,
     },
+    /// Loads below the force resolution of the model's stiffness.
+    #[error(
+        "the frame's stiffest members resolve forces only to about {floor:.1e} N, more than \
+         half its loads ({loads:.1e} N): its stiffnesses span beyond double precision — \
+         lower the stiffest section or raise the loads"
+    )]
+    Unresolvable {
+        /// The force floor, N.
+        floor: f64,
+        /// The largest load component, N or N·m.
+        loads: f64,
+    },
     /// The stiffness could not be factored in the memory there is.
     #[error("out of memory factoring the frame's stiffness ({detail})")]
     OutOfMemory {

@@ -37,6 +37,7 @@ impl StaticSolver {
         settings: &StaticSettings,
     ) -> Result<StaticSolution, MechanicsError> {
         settings.validate()?;
+        self.check_resolvable()?;
         match settings.path {
             PathControl::Load => Ok(load_control::follow(
                 self,
