@@ -10,10 +10,11 @@
 //! | `mesh` | 13 / 34 / 125 MB at 7.6k / 29k / 115k nodes | 16 MB + 1.2 kB/node |
 //! | `optimize` | 32 / 101 / 392 MB at the same sizes | 32 MB + 3.6 kB/node |
 //! | `design` | 197 / 610 MB at 7.6k / 29k nodes | 100 MB + 21 kB/node |
-//! | `frame` | 134 MB / 1.14 GB at 1e4 / 1e5 elements | 20 MB + 12 kB/element |
+//! | `frame` | 134 MB / 1.14 / 10.5 GB at 1e4 / 1e5 / 1e6 elements | 20 MB + 12 kB/element |
 //!
 //! (super-60m with 14, 28 and 56 rings; the cantilever benchmark with 1e4 and
-//! 1e5 elements). Commands that run several designs at once (`front`,
+//! 1e5 elements, and ten such cantilevers of 1e5 elements each: the frame
+//! file's maximum, 41 s). Commands that run several designs at once (`front`,
 //! `study`) multiply by the worker threads.
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -181,7 +182,7 @@ mod tests {
                 );
             }
         }
-        for (elements, peak) in [(1e4, 134_052e3), (1e5, 1_141_656e3)] {
+        for (elements, peak) in [(1e4, 134_052e3), (1e5, 1_141_656e3), (1e6, 10_237_708e3)] {
             let estimate = frame_memory(elements as u64) as f64;
             assert!((1.0..2.0).contains(&(estimate / peak)), "{elements}");
         }
