@@ -1,5 +1,6 @@
 //! The `ringmesh` command line: parses arguments, calls [`ringmesh::run`], prints.
-//! Exit codes: 0 success, 1 failure, 2 bad input (nothing is written then).
+//! Exit codes: 0 success, 1 failure, 2 bad input (nothing is written then), 3
+//! a `frame` run that ended before the full load (its results are written).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -418,6 +419,8 @@ fn main() -> ExitCode {
     ringmesh::resources::set_memory_limit(cli.max_memory);
     // SIGINT, SIGTERM, SIGHUP: no staging folder or temporary file is left.
     let _ = ctrlc::set_handler(|| ringmesh::report::abandon_all_and_exit(130));
+    // A run that wrote its results but ended before its target (exit 3).
+    let mut ended_early: Option<String> = None;
     let result = match &cli.command {
         Command::Mesh { scene, output } => ringmesh::run::mesh(scene, output.as_deref()).map(|m| {
             say!("scene: {}", m.scene);
@@ -743,6 +746,7 @@ fn main() -> ExitCode {
             ringmesh::run::frame(file, output.as_deref()).map(|(o, path)| {
                 say!("{}", frame_summary(&o));
                 say!("wrote {}", path.display());
+                ended_early = o.ended_early();
             })
         }
         Command::Truss {
@@ -780,7 +784,13 @@ fn main() -> ExitCode {
         }),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => match ended_early {
+            None => ExitCode::SUCCESS,
+            Some(reason) => {
+                eprintln!("ended before the full load: {reason}");
+                ExitCode::from(3)
+            }
+        },
         Err(error) => {
             eprintln!("error: {error}");
             ExitCode::from(if error.is_bad_input() { 2 } else { 1 })

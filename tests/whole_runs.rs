@@ -396,3 +396,28 @@ fn a_frame_whose_solution_overflows_is_an_error() {
     assert!(why.contains("resolve forces only to about"), "{why}");
     assert!(!out.exists());
 }
+
+/// A frame run that ends before the full load writes what it found and
+/// exits 3 with the reason (it exited 0): here a section whose stiffness
+/// stalls Newton at a load factor of 0.002.
+#[test]
+fn a_frame_run_that_ends_early_writes_its_state_and_exits_3() {
+    let root = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
+        .unwrap()
+        .replace("axial_n = 1e4", "axial_n = 1e12");
+    let path = root.path().join("frame.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = root.path().join("frame.json");
+    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
+        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let why = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{why}");
+    assert!(why.contains("ended before the full load"), "{why}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert!(json["load_factor"].as_f64().unwrap() < 1.0);
+    assert_ne!(json["termination"], "converged");
+}

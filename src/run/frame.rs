@@ -102,6 +102,17 @@ pub fn default_frame_output(frame_path: &Path) -> PathBuf {
     Path::new("results").join(stem).join("frame.json")
 }
 
+impl FrameOutput {
+    /// Why the run ended before its target — the full load — or `None` when
+    /// it reached it. The CLI exits 3 then, after writing what it found.
+    pub fn ended_early(&self) -> Option<String> {
+        match self.termination {
+            StaticTermination::Converged => None,
+            ref t => Some(t.to_string()),
+        }
+    }
+}
+
 /// `ringmesh frame`: reads a frame file, solves its statics and writes every
 /// node's position, displacement and rotation, the reactions and the solver's
 /// statistics as JSON (`output_path`, default [`default_frame_output`]).
