@@ -467,14 +467,16 @@ impl TiedNets {
 
     /// Stage 2 for the front design `q_front` whose ties pull with
     /// `tie_tensions`: the rear force densities closest to the mirror
-    /// `α q_front` that balance the plan ([`TiedNets::balance_plan`]), then
+    /// `α q_front` that balance the plan ([`TiedNets::balance_plan`], affine
+    /// in `α`), then
     /// the rear heights under the ties' pull, at the level `α` at which the
     /// rear net's interior cables carry the scene's mean tension
     /// ([`ReflectorMesh::rear_mean_tension_n`]). The level sets the rear
     /// net's depth (its shape is free): secant steps on `ln α` from the
     /// vertical-balance fit [`TiedNets::alpha`], which the mean tension
-    /// follows nearly in proportion (measured: 5 steps to 1e-13). A level
-    /// that cannot be reached keeps the best one and says so.
+    /// follows nearly in proportion (measured: 3 secant steps to 1e-13 on
+    /// small-hex and realistic-26m, 5 on paper-26m). A level that cannot be
+    /// reached keeps the best one and says so.
     fn rear_stage(
         &self,
         q_front: &[f64],
@@ -497,9 +499,27 @@ impl TiedNets {
             .filter(|&k| self.mesh.groups[k + n] == CableGroup::Rear)
             .collect();
         let target = self.mesh.rear_mean_tension_n;
+        // The balance is affine in the level: its weights scale with α², its
+        // start with α, so `q(α) = α q₁ + d` with `q₁` the unloaded balance of
+        // the mirror at α = 1 and `d` what the plan loads add — one or two
+        // factorisations for every secant step, not one per step.
+        let unloaded = self.balance_plan(&rear_plan, &q_front[..n], None)?;
+        let added: Option<Vec<f64>> = if plan_loads.iter().any(|p| p[0] != 0.0 || p[1] != 0.0) {
+            let loaded = self.balance_plan(&rear_plan, &q_front[..n], Some(&plan_loads))?;
+            Some(loaded.iter().zip(&unloaded).map(|(l, u)| l - u).collect())
+        } else {
+            None
+        };
         let at = |alpha: f64| -> Result<(RearStage, f64), UniformityError> {
-            let mirror: Vec<f64> = q_front[..n].iter().map(|q| alpha * q).collect();
-            let q = self.balance_plan(&rear_plan, &mirror, &plan_loads)?;
+            let q: Vec<f64> = match &added {
+                Some(added) => unloaded
+                    .iter()
+                    .zip(added)
+                    .map(|(u, d)| alpha * u + d)
+                    .collect(),
+                None => unloaded.iter().map(|u| alpha * u).collect(),
+            };
+            self.check_rear_tension(&q)?;
             let rear = self.rear.solve(&q, &rear_nodes, Some(&loads))?;
             let mean = interior
                 .iter()
@@ -576,14 +596,14 @@ impl TiedNets {
 
     /// The force densities closest to `q0` (relative least squares) in plan
     /// equilibrium with the loads' plan components `p` at the rear free
-    /// nodes: `q = q₀ − Q₀² Aᵀ μ`, `(A Q₀² Aᵀ) μ = A q₀ − p`, `A` the plan
+    /// nodes (`None`: no loads): `q = q₀ − Q₀² Aᵀ μ`, `(A Q₀² Aᵀ) μ = A q₀ − p`, `A` the plan
     /// equilibrium matrix (2 rows per free node; sparse Cholesky, one
     /// refinement step).
     fn balance_plan(
         &self,
         plan: &[[f64; 3]],
         q0: &[f64],
-        loads_n: &[[f64; 3]],
+        loads_n: Option<&[[f64; 3]]>,
     ) -> Result<Vec<f64>, UniformityError> {
         let structure = &self.rear;
         let rows = 2 * structure.free_nodes().len();
@@ -602,9 +622,11 @@ impl TiedNets {
         // The residual `A q − p`.
         let a_times = |q: &[f64]| {
             let mut r = vec![0.0; rows];
-            for (f, &i) in structure.free_nodes().iter().enumerate() {
-                r[2 * f] -= loads_n[i][0];
-                r[2 * f + 1] -= loads_n[i][1];
+            if let Some(loads_n) = loads_n {
+                for (f, &i) in structure.free_nodes().iter().enumerate() {
+                    r[2 * f] -= loads_n[i][0];
+                    r[2 * f + 1] -= loads_n[i][1];
+                }
             }
             for (k, &qk) in q.iter().enumerate() {
                 for (row, v) in column(k) {
@@ -648,6 +670,12 @@ impl TiedNets {
                 *qk -= q0[k] * q0[k] * at_mu;
             }
         }
+        Ok(q)
+    }
+
+    /// Refuses rear force densities that are not positive, naming the
+    /// cables.
+    fn check_rear_tension(&self, q: &[f64]) -> Result<(), UniformityError> {
         let negative: Vec<usize> = (0..q.len())
             .filter(|&k| q[k].is_nan() || q[k] <= 0.0)
             .collect();
@@ -664,6 +692,6 @@ impl TiedNets {
                 "cannot stay in tension with the deformed bottom hinges",
             ));
         }
-        Ok(q)
+        Ok(())
     }
 }
