@@ -5,22 +5,8 @@
 mod common;
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Stdio};
-
-/// Every file of a folder with its bytes, by name.
-fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let path = e.unwrap().path();
-            let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            (name, std::fs::read(&path).unwrap())
-        })
-        .collect();
-    files.sort();
-    files
-}
 
 /// `ringmesh design` on a copy of realistic-26m (≈ 3 s) writes its results;
 /// a second run on the same folder, killed (SIGKILL) as soon as it reports
@@ -48,7 +34,7 @@ fn a_design_run_killed_in_its_outer_loop_leaves_the_previous_results_intact() {
         "{}",
         String::from_utf8_lossy(&first.stderr)
     );
-    let before = snapshot(&out);
+    let before = common::snapshot(&out);
     let names: Vec<&str> = before.iter().map(|(n, _)| n.as_str()).collect();
     for expected in ["design.json", "cables.csv", "convergence.csv", "model.vtu"] {
         assert!(names.contains(&expected), "{names:?}");
@@ -76,7 +62,7 @@ fn a_design_run_killed_in_its_outer_loop_leaves_the_previous_results_intact() {
     let status = second.wait().unwrap();
     assert!(!status.success(), "the run finished before it was killed");
 
-    let after = snapshot(&out);
+    let after = common::snapshot(&out);
     assert_eq!(
         after.iter().map(|(n, _)| n).collect::<Vec<_>>(),
         before.iter().map(|(n, _)| n).collect::<Vec<_>>(),

@@ -23,23 +23,9 @@ const SET: [&str; 7] = [
     "surface-error.png",
 ];
 
-/// Every entry of a folder with its bytes, by name.
-fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let path = e.unwrap().path();
-            let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            (name, std::fs::read(&path).unwrap_or_default())
-        })
-        .collect();
-    files.sort();
-    files
-}
-
 /// The names in a folder.
 fn names(dir: &Path) -> Vec<String> {
-    snapshot(dir).into_iter().map(|(n, _)| n).collect()
+    common::snapshot(dir).into_iter().map(|(n, _)| n).collect()
 }
 
 /// `design` of small-hex into `out`, not waited for.
@@ -106,7 +92,7 @@ fn a_run_killed_while_writing_leaves_the_previous_set_or_the_new_one() {
     let (_root, scene, out) = scratch();
     let first = spawn_design(&scene, &out).wait_with_output().unwrap();
     assert!(first.status.success(), "{first:?}");
-    let mut previous = snapshot(&out);
+    let mut previous = common::snapshot(&out);
     complete_set(&out);
     let (mut kept, mut replaced) = (0, 0);
     for trial in 0..24 {
@@ -142,7 +128,7 @@ fn a_run_killed_while_writing_leaves_the_previous_set_or_the_new_one() {
         };
         let _ = child.kill();
         let status = child.wait().unwrap();
-        let now = snapshot(&out);
+        let now = common::snapshot(&out);
         if now == previous {
             kept += 1;
         } else {
@@ -238,7 +224,7 @@ fn a_run_out_of_space_fails_and_keeps_the_previous_set() {
     let (_root, scene, out) = scratch();
     let first = spawn_design(&scene, &out).wait_with_output().unwrap();
     assert!(first.status.success(), "{first:?}");
-    let before = snapshot(&out);
+    let before = common::snapshot(&out);
     // SIGXFSZ ignored, so that the write fails with EFBIG instead of the
     // signal killing the process.
     let full = Command::new("sh")
@@ -258,7 +244,7 @@ fn a_run_out_of_space_fails_and_keeps_the_previous_set() {
         why.contains(&named) && why.contains("File too large"),
         "{why}"
     );
-    assert!(snapshot(&out) == before, "the folder changed");
+    assert!(common::snapshot(&out) == before, "the folder changed");
     assert!(staging_beside(&out).is_empty());
 }
 
@@ -271,15 +257,12 @@ fn an_unwritable_folder_is_refused_before_computing() {
     std::fs::write(&blocker, "not a folder").unwrap();
     let out = blocker.join("results");
     let clock = Instant::now();
-    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args([
-            "design",
-            scene.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = common::ringmesh(&[
+        "design",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     let why = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{why}");
     assert!(why.contains("cannot write into the output folder"), "{why}");
@@ -291,11 +274,7 @@ fn an_unwritable_folder_is_refused_before_computing() {
         &format!("name = \"{}\"", "x".repeat(300)),
     );
     std::fs::write(&long, text).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(["design", long.to_str().unwrap()])
-        .current_dir(root.path())
-        .output()
-        .unwrap();
+    let o = common::ringmesh_in(&["design", long.to_str().unwrap()], root.path());
     let why = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{why}");
     assert!(why.contains("name") && why.contains("at most 128"), "{why}");
@@ -310,10 +289,7 @@ fn an_unwritable_folder_is_refused_before_computing() {
 fn a_run_beyond_the_memory_limit_is_refused_before_computing() {
     let (_root, scene, out) = scratch();
     let refused = |args: &[&str], needles: &[&str]| {
-        let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-            .args(args)
-            .output()
-            .unwrap();
+        let o = common::ringmesh(args);
         let why = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {why}");
         for needle in needles {
@@ -341,60 +317,48 @@ fn a_run_beyond_the_memory_limit_is_refused_before_computing() {
     );
 }
 
+/// The cantilever benchmark with `from` replaced by `to`, run by `frame`
+/// in a scratch folder: its exit code, its message, and its output path.
+fn cantilever_with(from: &str, to: &str) -> (Option<i32>, String, PathBuf, tempfile::TempDir) {
+    let root = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml")).unwrap();
+    assert!(text.contains(from), "no {from}");
+    let path = root.path().join("frame.toml");
+    std::fs::write(&path, text.replace(from, to)).unwrap();
+    let out = root.path().join("frame.json");
+    let o = common::ringmesh(&["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let why = String::from_utf8_lossy(&o.stderr).into_owned();
+    (o.status.code(), why, out, root)
+}
+
 /// A result that is not finite is an error (exit 1) naming where, never a
 /// success: a 1e200 moment on the cantilever gave "converged at the full
-/// load" with infinite positions; a section beyond any is refused (exit 2).
+/// load" with infinite positions; a section beyond any is refused (exit 2),
+/// and so are loads below the force floor of the stiffness.
 #[test]
 fn a_frame_whose_solution_overflows_is_an_error() {
-    let root = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
-        .unwrap()
-        .replace(
-            "moment_nm = [0.0, 0.0, 62.83185307179586]",
-            "moment_nm = [0.0, 0.0, 1e200]",
-        );
-    let path = root.path().join("frame.toml");
-    std::fs::write(&path, text).unwrap();
-    let out = root.path().join("frame.json");
-    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let why = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{why}");
-    assert!(why.contains("not finite"), "{why}");
-    assert!(!out.exists());
-
-    // A section stiffer than any (EA = 1e300: its roundoff ε·EA exceeds any
-    // load) is refused naming it; it 'converged' undeformed.
-    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
-        .unwrap()
-        .replace("axial_n = 1e4", "axial_n = 1e300");
-    std::fs::write(&path, text).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let why = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{why}");
-    assert!(why.contains("rods[0].axial_n"), "{why}");
-    assert!(!out.exists());
-
-    // Within the bound, EA = 1e16 N against EI = 100 N·m²: the force floor
-    // of its stiffness (1.4e3 N) exceeds the 62.8 N·m load, and the solve
-    // 'converged' undeformed in 0 iterations; now it is refused, saying so.
-    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
-        .unwrap()
-        .replace("axial_n = 1e4", "axial_n = 1e16");
-    std::fs::write(&path, text).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let why = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{why}");
-    assert!(why.contains("resolve forces only to about"), "{why}");
-    assert!(!out.exists());
+    let moment = "moment_nm = [0.0, 0.0, 62.83185307179586]";
+    let cases = [
+        (moment, "moment_nm = [0.0, 0.0, 1e200]", 1, "not finite"),
+        // EA = 1e300: its roundoff ε·EA exceeds any load; it 'converged'
+        // undeformed.
+        ("axial_n = 1e4", "axial_n = 1e300", 2, "rods[0].axial_n"),
+        // Within the bound, EA = 1e16 N against EI = 100 N·m²: the force
+        // floor of its stiffness (1.4e3 N) exceeds the 62.8 N·m load, and the
+        // solve 'converged' undeformed in 0 iterations.
+        (
+            "axial_n = 1e4",
+            "axial_n = 1e16",
+            2,
+            "resolve forces only to about",
+        ),
+    ];
+    for (from, to, code, needle) in cases {
+        let (status, why, out, _root) = cantilever_with(from, to);
+        assert_eq!(status, Some(code), "{to}: {why}");
+        assert!(why.contains(needle), "{to}: {why}");
+        assert!(!out.exists(), "{to} wrote");
+    }
 }
 
 /// A frame run that ends before the full load writes what it found and
@@ -402,19 +366,8 @@ fn a_frame_whose_solution_overflows_is_an_error() {
 /// stalls Newton at a load factor of 0.002.
 #[test]
 fn a_frame_run_that_ends_early_writes_its_state_and_exits_3() {
-    let root = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(common::problem("frames/cantilever-moment.toml"))
-        .unwrap()
-        .replace("axial_n = 1e4", "axial_n = 1e12");
-    let path = root.path().join("frame.toml");
-    std::fs::write(&path, text).unwrap();
-    let out = root.path().join("frame.json");
-    let o = Command::new(env!("CARGO_BIN_EXE_ringmesh"))
-        .args(["frame", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let why = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(3), "{why}");
+    let (status, why, out, _root) = cantilever_with("axial_n = 1e4", "axial_n = 1e12");
+    assert_eq!(status, Some(3), "{why}");
     assert!(why.contains("ended before the full load"), "{why}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
