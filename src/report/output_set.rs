@@ -219,44 +219,18 @@ impl OutputSet {
         &self.target
     }
 
-    /// Marks every written file of the set with the run's identifier, where
-    /// its format has room for a note that readers skip: a comment in SVG and
-    /// VTU (XML), a `tEXt` chunk in PNG. CSV has no such room (a comment line
-    /// breaks most CSV readers) and JSON no comments: [`OutputSet::manifest`]
-    /// covers them.
+    /// Seals the files written so far: marks each with the run's identifier
+    /// where its format has room for a note readers skip (a comment in SVG
+    /// and VTU, a `tEXt` chunk in PNG; CSV has none — a comment line breaks
+    /// most CSV readers — and JSON no comments), and returns the run's record
+    /// of them: each file's size and FNV-1a hash, so that a folder holding
+    /// files of two runs is found out ([`check_manifest`]). One read of each
+    /// file; the set's JSON report, written after, carries the record.
     ///
     /// # Errors
     /// A staged file could not be read or rewritten.
-    pub fn stamp(&self) -> Result<(), ReportError> {
+    pub fn seal(&self) -> Result<RunRecord, ReportError> {
         let note = format!("ringmesh run {}", self.run_id);
-        for name in &self.names {
-            let path = self.staging.join(name);
-            let stamped = match path.extension().and_then(|e| e.to_str()) {
-                Some("svg" | "vtu") => {
-                    let text = fs::read_to_string(&path).map_err(at(&path))?;
-                    xml_with_comment(&text, &note).into_bytes()
-                }
-                Some("png") => {
-                    let bytes = fs::read(&path).map_err(at(&path))?;
-                    match png_with_text(&bytes, "ringmesh-run", &self.run_id) {
-                        Some(bytes) => bytes,
-                        None => continue,
-                    }
-                }
-                _ => continue,
-            };
-            super::write_atomic(&path, &stamped)?;
-        }
-        Ok(())
-    }
-
-    /// The run's record of the files written so far: each file's size and
-    /// FNV-1a hash, so that a folder holding files of two runs is found out
-    /// ([`check_manifest`]). For the set's JSON report, written last.
-    ///
-    /// # Errors
-    /// A staged file could not be read.
-    pub fn manifest(&self) -> Result<RunRecord, ReportError> {
         let mut files = Vec::new();
         for name in &self.names {
             let path = self.staging.join(name);
@@ -264,6 +238,20 @@ impl OutputSet {
                 continue;
             }
             let bytes = fs::read(&path).map_err(at(&path))?;
+            let stamped = match path.extension().and_then(|e| e.to_str()) {
+                Some("svg" | "vtu") => std::str::from_utf8(&bytes)
+                    .ok()
+                    .map(|text| xml_with_comment(text, &note).into_bytes()),
+                Some("png") => png_with_text(&bytes, "ringmesh-run", &self.run_id),
+                _ => None,
+            };
+            let bytes = match stamped {
+                Some(stamped) => {
+                    super::write_atomic(&path, &stamped)?;
+                    stamped
+                }
+                None => bytes,
+            };
             files.push(FileRecord {
                 name: name.clone(),
                 bytes: bytes.len(),
@@ -612,8 +600,7 @@ mod tests {
         let set = OutputSet::begin(&dir, &["a.csv", "b.svg"]).unwrap();
         fs::write(set.path("a.csv"), "x,y\n").unwrap();
         fs::write(set.path("b.svg"), "<svg/>").unwrap();
-        set.stamp().unwrap();
-        let record = set.manifest().unwrap();
+        let record = set.seal().unwrap();
         set.commit().unwrap();
         let svg = fs::read_to_string(dir.join("b.svg")).unwrap();
         assert!(svg.contains(&record.id), "{svg}");

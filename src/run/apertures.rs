@@ -68,7 +68,7 @@ pub fn apertures(
     aperture_plot(&results, &title, &png, &svg)?;
     write_atomic(&csv, aperture_csv(&results).as_bytes())?;
     write_json(&json, &results)?;
-    set.stamp()?;
+    set.seal()?;
     let written = set.commit()?;
     Ok(AperturesOutcome { results, written })
 }

@@ -183,8 +183,7 @@ fn write_design(
         &path("cables.csv"),
         cables_csv(network, &report.net, &scene.cables).as_bytes(),
     )?;
-    set.stamp()?;
-    let run = set.manifest()?;
+    let run = set.seal()?;
     report.timings.writing_s = writing.elapsed().as_secs_f64();
     report.timings.total_s = clock.elapsed().as_secs_f64();
     write_json(&path("design.json"), &WithRun { run: &run, report })?;

@@ -123,6 +123,6 @@ pub(crate) fn write_front(
         &set.path("front.svg"),
     )?;
     write_atomic(&set.path("front.csv"), csv.as_bytes())?;
-    set.stamp()?;
+    set.seal()?;
     Ok(set.commit()?)
 }

@@ -33,7 +33,7 @@ pub fn mesh(scene_path: &Path, output_dir: Option<&Path>) -> Result<MeshOutcome,
     let vtu = network_vtu(&mesh.network, None, None);
     write_json(&set.path("network.json"), &mesh.network)?;
     write_atomic(&set.path("mesh.vtu"), vtu.as_bytes())?;
-    set.stamp()?;
+    set.seal()?;
     Ok(MeshOutcome {
         scene: scene.name,
         summary,

@@ -38,7 +38,7 @@ pub fn optimize(
     let design = solver.build(None).solve(&problem)?.feasible()?;
     let csv = cables_csv(&mesh.network, &design, &scene.cables);
     write_atomic(&set.path("cables.csv"), csv.as_bytes())?;
-    let run = set.manifest()?;
+    let run = set.seal()?;
     let file = DesignFile {
         scene: &scene.name,
         design: &design,

@@ -176,6 +176,6 @@ pub(crate) fn write_study(
         format!("{scene}: what accuracy costs in time (designs as built on the reference truss)");
     study_plot(rows, &title, &png, &svg)?;
     write_atomic(&csv_path, csv.as_bytes())?;
-    set.stamp()?;
+    set.seal()?;
     Ok(set.commit()?)
 }
