@@ -88,8 +88,15 @@ pub struct StudyOutcome {
     pub written: Vec<PathBuf>,
 }
 
+/// The study's file stem, as a literal (`concat!` builds [`FILES`] from it).
+macro_rules! stem {
+    () => {
+        "accuracy-vs-time"
+    };
+}
+
 /// The name of the study's table and plots.
-pub const STUDY_STEM: &str = "accuracy-vs-time";
+pub const STUDY_STEM: &str = stem!();
 
 /// `ringmesh study`: what accuracy costs in time ([`crate::study`]). Writes
 /// `accuracy-vs-time.csv`, `.png` and `.svg`; with a `shard`, only that
@@ -158,9 +165,9 @@ pub fn study(
 
 /// The files of a whole study (stem [`STUDY_STEM`]).
 pub(crate) const FILES: [&str; 3] = [
-    "accuracy-vs-time.csv",
-    "accuracy-vs-time.png",
-    "accuracy-vs-time.svg",
+    concat!(stem!(), ".csv"),
+    concat!(stem!(), ".png"),
+    concat!(stem!(), ".svg"),
 ];
 
 /// `accuracy-vs-time.csv` (the table `csv`), `.png`, `.svg` (drawn from
