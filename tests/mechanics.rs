@@ -12,11 +12,12 @@ use ringmesh::frame::cantilever;
 use ringmesh::mechanics::rotation::{exp, log, skew, tangent};
 use ringmesh::mechanics::{
     ElementKind, Frame, JointKind, MechanicsError, ModelBuilder, NodeId, PathControl, Rod, RodSpec,
-    Section, StaticSettings, StaticSolution, StaticSolver, StaticTermination,
+    StaticSettings, StaticSolution, StaticSolver, StaticTermination,
 };
 
 mod common;
 
+use common::frames::{von_mises, von_mises_limit, von_mises_load, VM_RISE_M};
 use common::{angle_between, assert_quadratic, Random};
 
 const EPS: f64 = f64::EPSILON;
@@ -568,75 +569,6 @@ fn fixed_joint_transmits_all_six_components() {
 
 // ---------------------------------------------------------------------------
 // Limit points: the von Mises truss
-
-/// Half span, rise (m) and bar stiffness EA (N) of the truss: a shallow truss
-/// (rise/span 0.05) of bars that neither buckle (Euler load π²EI/L₀² ≈ 980 N
-/// against a bar force below 50 N) nor bend (loads at the pins only).
-const VM_HALF_SPAN_M: f64 = 1.0;
-const VM_RISE_M: f64 = 0.1;
-const VM_EA_N: f64 = 1e4;
-
-/// The von Mises truss: two bars from (∓b, 0, 0) to the apex (0, h, 0), one
-/// element each, pinned about z at the supports (out of plane they are
-/// clamped), joined at the apex by a spherical joint, the apex loaded
-/// downward by `load_n`.
-fn von_mises(load_n: f64) -> (StaticSolver, NodeId) {
-    let section = Section {
-        axial_n: VM_EA_N,
-        shear_n: [1e4, 1e4],
-        torsion_nm2: 100.0,
-        bending_nm2: [100.0, 100.0],
-    };
-    let spec = RodSpec {
-        section,
-        elements: 1,
-        kind: ElementKind::Se3,
-    };
-    let apex = Vector3::new(0.0, VM_RISE_M, 0.0);
-    let mut b = ModelBuilder::new();
-    let left = b.add_rod(
-        Vector3::new(-VM_HALF_SPAN_M, 0.0, 0.0),
-        apex,
-        Vector3::z(),
-        &spec,
-    );
-    let right = b.add_rod(
-        Vector3::new(VM_HALF_SPAN_M, 0.0, 0.0),
-        apex,
-        Vector3::z(),
-        &spec,
-    );
-    let pin = [true, true, true, true, true, false];
-    b.fix(left.start(), pin);
-    b.fix(right.start(), pin);
-    b.add_joint(JointKind::Spherical, left.end(), right.end(), apex);
-    b.add_load(
-        left.end(),
-        Vector3::new(0.0, -load_n, 0.0),
-        Vector3::zeros(),
-    );
-    (StaticSolver::new(b.build().unwrap()).unwrap(), left.end())
-}
-
-/// The apex load that holds the apex at height `y`. Straight bars of length
-/// `L = √(b² + y²)` carry `N = EA (L − L₀)/L₀` (the elements' axial strain),
-/// so vertical equilibrium gives `P(y) = −2 N y/L = 2 EA y (1/L − 1/L₀)`.
-fn von_mises_load(y: f64) -> f64 {
-    let (b, h) = (VM_HALF_SPAN_M, VM_RISE_M);
-    let l0 = (b * b + h * h).sqrt();
-    let l = (b * b + y * y).sqrt();
-    2.0 * VM_EA_N * y * (1.0 / l - 1.0 / l0)
-}
-
-/// The limit load: `dP/dy = 2EA (b²/L³ − 1/L₀) = 0` at `L³ = b² L₀`
-/// (≈ 3.81 N here; the shallow-truss formula `EA h³/(3√3 b³)·2` gives 3.85 N).
-fn von_mises_limit() -> (f64, f64) {
-    let (b, h) = (VM_HALF_SPAN_M, VM_RISE_M);
-    let l0 = (b * b + h * h).sqrt();
-    let l = (b * b * l0).cbrt();
-    let y = (l * l - b * b).sqrt();
-    (von_mises_load(y), y)
-}
 
 #[test]
 fn arc_length_passes_the_von_mises_limit_point() {

@@ -131,6 +131,9 @@ fn newton(
     let (mut predictor, mut previous) = (0.0, 0.0);
     let mut first = f64::NAN;
     let mut damped = None;
+    // The last increment passed the increment test: the state it reached
+    // is converged whatever the force test says.
+    let mut increment_small = false;
     for it in 0..=settings.max_iterations {
         let ev = damped
             .take()
@@ -141,7 +144,7 @@ fn newton(
         if !force.is_finite() {
             break;
         }
-        if converged {
+        if converged || increment_small {
             run.end = NewtonEnd::Converged;
             run.reactions = ev.reactions;
             break;
@@ -173,6 +176,7 @@ fn newton(
             run.negative_curvature = true;
         }
         let size = wdot(w, &delta, &delta).sqrt();
+        let small = solver.increment_converged(&delta, w, settings);
         let Some(max_predictor) = max_predictor else {
             // No branch tests (the step is not driven by dead loads):
             // damped Newton, the step halved while it raises the residual.
@@ -194,6 +198,7 @@ fn newton(
                 let (after, _) = solver.converged(&trial, lambda, settings);
                 if after < force {
                     damped = Some(trial);
+                    increment_small = small && step == 1.0;
                     break;
                 }
                 state.clone_from(&start);
@@ -228,6 +233,7 @@ fn newton(
             *a += d;
         }
         solver.system().apply(state, &delta, 1.0);
+        increment_small = small;
     }
     run.secant = wdot(w, &increment, &increment).sqrt();
     run

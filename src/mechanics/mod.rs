@@ -19,6 +19,10 @@
 //! * `load_control` — Newton–Raphson with adaptive load stepping;
 //!   `arc_length` — arc-length continuation through limit points;
 //!   `stability` — the stability of one equilibrium;
+//! * `corrector` — Newton on equilibrium and one path constraint (load,
+//!   arc length, a displacement); `path` — path following to a target
+//!   ([`StaticSolver::follow_path`]), its steps recorded; `critical` —
+//!   limit and bifurcation points located on it, branch switching;
 //! * `statics` — the solver's entry points ([`StaticSolver::solve`], …);
 //! * `limit` — the limit load ([`limit_load_factor`]).
 //!
@@ -30,11 +34,14 @@ mod assembly;
 mod beam;
 mod cable;
 mod condensed;
+mod corrector;
+mod critical;
 mod joint;
 mod limit;
 mod load_control;
 mod model;
 mod node;
+mod path;
 pub mod rotation;
 mod settings;
 mod solver;
@@ -49,6 +56,7 @@ pub use joint::JointKind;
 pub use limit::{limit_load_factor, LimitBound, LimitSearch};
 pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, Rod, RodSpec};
 pub use node::{Frame, NodeId};
+pub use path::{CriticalKind, CriticalPoint, PathPoint, PathSolution, PathSpec, PathTarget};
 pub use settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
 pub use solver::StaticSolver;
 pub use stability::{Mode, Stability};

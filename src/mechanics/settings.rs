@@ -71,9 +71,18 @@ pub enum PathControl {
     /// Load control: λ ramped to 1 with adaptive steps.
     #[default]
     Load,
-    /// Arc-length control (cylindrical, Crisfield): follows the path through
-    /// limit points.
+    /// Arc-length control: follows the path through limit points in load
+    /// and in displacement (cylindrical in [`StaticSolver::solve`], the
+    /// limit search; spherical in [`StaticSolver::follow_path`]).
+    ///
+    /// [`StaticSolver::solve`]: super::StaticSolver::solve
+    /// [`StaticSolver::follow_path`]: super::StaticSolver::follow_path
     ArcLength,
+    /// Displacement control of one node's translation component
+    /// ([`PathSpec::control`](super::PathSpec::control)): follows the path
+    /// through limit points in load, not in that displacement. Path
+    /// following only.
+    Displacement,
 }
 
 /// Settings of the static solver: plain data with defaults.
@@ -91,8 +100,20 @@ pub struct StaticSettings {
     pub min_step: f64,
     /// Largest number of converged steps.
     pub max_steps: usize,
-    /// Load or arc-length control.
+    /// Load, arc-length or displacement control.
     pub path: PathControl,
+    /// Path following: the largest step, in load-factor units of the first
+    /// (linear) step — an arc length of `max_step` is the length of the
+    /// linear path from the start to `Δλ = max_step`; a displacement step
+    /// of `max_step` that of the linear response to it.
+    pub max_step: f64,
+    /// Path following: the lowest eigenvalue of the stiffness on the joints'
+    /// constraints at every converged step, and bifurcation points located
+    /// where it crosses zero without a load extremum.
+    pub stability: bool,
+    /// Path following: at the first bifurcation point, leave the path for
+    /// the bifurcated branch (a step along the buckling mode).
+    pub branch_switch: bool,
 }
 
 impl Default for StaticSettings {
@@ -104,6 +125,9 @@ impl Default for StaticSettings {
             min_step: 1e-5,
             max_steps: 500,
             path: PathControl::Load,
+            max_step: 0.1,
+            stability: true,
+            branch_switch: false,
         }
     }
 }
@@ -130,6 +154,9 @@ impl StaticSettings {
         }
         if self.max_steps == 0 {
             return bad("max_steps", "must be at least 1");
+        }
+        if !(self.max_step >= self.min_step && self.max_step <= 1e6) {
+            return bad("max_step", "must be in [min_step, 1e6]");
         }
         Ok(())
     }

@@ -142,6 +142,25 @@ impl StaticSolver {
         )
     }
 
+    /// The Newton increment test, the residual scaled by the stiffness:
+    /// converged when the increment `δ = −J⁻¹R` (weighted norm) is at most
+    /// `tol · L`, `L` the frame's size. The force test of
+    /// [`StaticSolver::converged`] compares forces with the loads; a very
+    /// stiff member (GA = 1e4·EA, EA = 1e8·EI/L²) leaves a roundoff in its
+    /// forces far above that test — 2.5e-9 N against 1e-10 N on a shear-rigid
+    /// cantilever, which then stalled at load factor 0 — while the same
+    /// roundoff moves the nodes only by `roundoff / stiffness`. Newton
+    /// converging quadratically, the state after such an increment is an
+    /// equilibrium to `(tol·L)²/L`.
+    pub(super) fn increment_converged(
+        &self,
+        delta: &[f64],
+        w: &[f64],
+        settings: &StaticSettings,
+    ) -> bool {
+        wdot(w, delta, delta).sqrt() <= settings.tolerance * self.length_scale
+    }
+
     /// Weights of the weighted norm: 1 on translations, `ℓ` (the mean
     /// element length) on rotations, 0 on multipliers.
     pub(super) fn weights(&self) -> Vec<f64> {

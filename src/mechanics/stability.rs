@@ -75,6 +75,49 @@ pub(super) fn stability(
     state: &State,
     lambda: f64,
 ) -> Result<Stability, MechanicsError> {
+    let run = inverse_iteration(solver, state, lambda, true)?;
+    Ok(Stability {
+        lowest_stiffness_n_per_m: run.eigenvalue,
+        stable: !run.negative,
+        iterations: run.iterations,
+        mode: translations(solver, &run.vector),
+    })
+}
+
+/// The least-magnitude eigenvalue of the stiffness on the joints'
+/// constraints at `state`, signed, and its eigenvector in unknown order
+/// (multipliers zero, weighted norm 1): inverse iteration run to
+/// convergence (not stopped at the first negative curvature, as
+/// [`stability`] is), so that the value is a continuous function along a
+/// path and crosses zero where the path meets a critical point.
+pub(super) fn lowest_eigenpair(
+    solver: &StaticSolver,
+    state: &State,
+    lambda: f64,
+) -> Result<EigenPair, MechanicsError> {
+    inverse_iteration(solver, state, lambda, false)
+}
+
+/// The outcome of inverse iteration.
+pub(super) struct EigenPair {
+    /// The Rayleigh quotient `zᵀHz / zᵀW²z` of the last iterate, N/m.
+    pub eigenvalue: f64,
+    /// Some iterate had a curvature below the noise: negative.
+    pub negative: bool,
+    /// Inverse iterations.
+    pub iterations: usize,
+    /// The last iterate (unknown order, multipliers zero), weighted norm 1.
+    pub vector: Vec<f64>,
+}
+
+/// Inverse iteration with the tangent's factor (module doc), stopped at the
+/// first direction of negative curvature when `stop_on_negative`.
+fn inverse_iteration(
+    solver: &StaticSolver,
+    state: &State,
+    lambda: f64,
+    stop_on_negative: bool,
+) -> Result<EigenPair, MechanicsError> {
     let system = solver.system();
     let ev = system.evaluate(solver.model(), state, lambda);
     let lu = system.factor(&ev.values)?;
@@ -91,6 +134,7 @@ pub(super) fn stability(
         })
         .collect();
     let mut estimate = f64::NAN;
+    let mut negative = false;
     for iteration in 1..=MAX_ITERATIONS {
         let mut rhs = Mat::from_fn(system.n_rows, 1, |i, _| {
             if i < n_free {
@@ -112,24 +156,24 @@ pub(super) fn stability(
         }
         let previous = estimate;
         estimate = curvature / (z_norm * z_norm);
-        let negative = curvature < -CURVATURE_NOISE * z_norm * x_norm;
+        negative |= curvature < -CURVATURE_NOISE * z_norm * x_norm;
         let settled = (estimate - previous).abs() <= EIGENVALUE_TOLERANCE * estimate.abs();
-        if negative || settled || iteration == MAX_ITERATIONS {
-            return Ok(Stability {
-                lowest_stiffness_n_per_m: estimate,
-                stable: !negative,
+        x = z.iter().map(|v| v / z_norm).collect();
+        if (negative && stop_on_negative) || settled || iteration == MAX_ITERATIONS {
+            return Ok(EigenPair {
+                eigenvalue: estimate,
+                negative,
                 iterations: iteration,
-                mode: translations(solver, &z),
+                vector: x,
             });
         }
-        x = z.iter().map(|v| v / z_norm).collect();
     }
     unreachable!("the last iteration returns")
 }
 
 /// Every node's translation in the unknowns `z` (0 where fixed), scaled so
 /// that the largest is 1 m.
-fn translations(solver: &StaticSolver, z: &[f64]) -> Mode {
+pub(super) fn translations(solver: &StaticSolver, z: &[f64]) -> Mode {
     let system = solver.system();
     let mut t: Vec<[f64; 3]> = (0..solver.model().node_count())
         .map(|n| std::array::from_fn(|c| system.unknown(n, c).map_or(0.0, |i| z[i])))

@@ -48,6 +48,11 @@ impl StaticSolver {
             PathControl::ArcLength => {
                 Ok(arc_length::follow(self, start, start_load_factor, settings))
             }
+            PathControl::Displacement => Err(MechanicsError::invalid(
+                "solver.path",
+                "displacement control names the controlled node: follow the path \
+                 (StaticSolver::follow_path) instead",
+            )),
         }
     }
 

@@ -5,6 +5,7 @@
 //! file declares `mod common;` and takes what it needs.
 #![allow(dead_code)] // each test file uses its own part
 
+pub mod frames;
 pub mod hexnet;
 
 use std::f64::consts::TAU;
