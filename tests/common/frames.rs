@@ -74,3 +74,78 @@ pub fn von_mises_limit() -> (f64, f64) {
     let y = (l * l - b * b).sqrt();
     (von_mises_load(y), y)
 }
+
+/// Length (m) and weak bending stiffness (N·m²) of the Euler columns; the
+/// other plane 10 × stiffer, so that one mode buckles first, and EA, GA
+/// 1e6 × EI/L², so that shortening and shear move the critical load by
+/// ~1e-6 of it, far below the discretisation's h² error.
+pub const COLUMN_LENGTH_M: f64 = 1.0;
+pub const COLUMN_EI_NM2: f64 = 1.0;
+
+/// How an Euler column is held.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnEnds {
+    /// Clamped at x = 0, free at x = L: `P_cr = π²EI/(4L²)`, mode `1 − cos(πx/2L)`.
+    ClampedFree,
+    /// Pinned at both ends (the far end free to slide along x, every end
+    /// free to turn but not about the axis): `P_cr = π²EI/L²`, mode `sin(πx/L)`.
+    PinnedPinned,
+}
+
+impl ColumnEnds {
+    /// The continuum critical load, N.
+    pub fn critical_load_n(self) -> f64 {
+        let euler = std::f64::consts::PI.powi(2) * COLUMN_EI_NM2 / COLUMN_LENGTH_M.powi(2);
+        match self {
+            ColumnEnds::ClampedFree => euler / 4.0,
+            ColumnEnds::PinnedPinned => euler,
+        }
+    }
+
+    /// The continuum mode's lateral deflection at `x`, largest 1.
+    pub fn mode(self, x: f64) -> f64 {
+        let s = x / COLUMN_LENGTH_M;
+        match self {
+            ColumnEnds::ClampedFree => 1.0 - (std::f64::consts::FRAC_PI_2 * s).cos(),
+            ColumnEnds::PinnedPinned => (std::f64::consts::PI * s).sin(),
+        }
+    }
+}
+
+/// A straight column along x of `elements` SE(3) elements, compressed by
+/// `load_n` at x = L; returns the solver and the rod's nodes. The section's
+/// weak bending is about z (deflection along y).
+pub fn euler_column(
+    ends: ColumnEnds,
+    elements: usize,
+    load_n: f64,
+    stiff_sections: (f64, f64),
+) -> (StaticSolver, Vec<NodeId>) {
+    let (axial, shear) = stiff_sections;
+    let spec = RodSpec {
+        section: Section {
+            axial_n: axial,
+            shear_n: [shear, shear],
+            torsion_nm2: COLUMN_EI_NM2,
+            bending_nm2: [COLUMN_EI_NM2, 10.0 * COLUMN_EI_NM2],
+        },
+        elements,
+        kind: ElementKind::Se3,
+    };
+    let mut b = ModelBuilder::new();
+    let rod = b.add_rod(
+        Vector3::zeros(),
+        Vector3::new(COLUMN_LENGTH_M, 0.0, 0.0),
+        Vector3::z(),
+        &spec,
+    );
+    match ends {
+        ColumnEnds::ClampedFree => b.fix(rod.start(), [true; 6]),
+        ColumnEnds::PinnedPinned => {
+            b.fix(rod.start(), [true, true, true, true, false, false]);
+            b.fix(rod.end(), [false, true, true, false, false, false]);
+        }
+    }
+    b.add_load(rod.end(), Vector3::new(-load_n, 0.0, 0.0), Vector3::zeros());
+    (StaticSolver::new(b.build().unwrap()).unwrap(), rod.nodes)
+}
