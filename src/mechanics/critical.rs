@@ -7,7 +7,8 @@
 //!   the arc length `σ/√(‖t‖² + ψ²)`, `t = J⁻¹f̂` the tangent and `σ` its
 //!   orientation, for displacement control `1/t_c` — zero where the load
 //!   is extremal. The load factor there is the path's extremum, accurate
-//!   to the square of the fraction's error;
+//!   to the square of the fraction's error. A sign change where the slope
+//!   is at noise level at both ends ([`SLOPE_NOISE`]) is not one;
 //! * a bifurcation point: the lowest eigenvalue of the stiffness on the
 //!   joints' constraints ([`super::stability::lowest_eigenpair`]), when it
 //!   changes sign with no load extremum in the step. A sign change that
@@ -35,6 +36,12 @@ const LOCATE_TOLERANCE: f64 = 1e-11;
 /// the eigenvalue there is below this fraction of its values at the step's
 /// ends.
 const CROSSING: f64 = 1e-3;
+
+/// A sign change of the load slope counts as a limit point only when the
+/// slope at one end of the step exceeds this fraction of its value at the
+/// start: on a branch whose load is flat to roundoff (a column just past
+/// its bifurcation, λ − λ_c ~ 1e-10) the slope's sign is noise.
+const SLOPE_NOISE: f64 = 1e-6;
 
 /// Attempts, each with a step a quarter of the last, to leave a
 /// bifurcation point along its mode.
@@ -232,7 +239,8 @@ pub(super) fn between(
 ) -> Option<(Node, (Corrected, Node))> {
     let (g0, g1) = (from.indicators.load_slope, to.indicators.load_slope);
     let after_point = run.points.len().saturating_sub(2);
-    if g0 * g1 < 0.0 {
+    let noise = SLOPE_NOISE * follower.start_slope;
+    if g0 * g1 < 0.0 && g0.abs().max(g1.abs()) > noise {
         let (_, node, _) = locate(follower, from, previous, h, (g0, g1), |_, n| {
             n.indicators.load_slope
         })?;

@@ -15,7 +15,8 @@
 //!   positive), so it never turns back onto the path already travelled;
 //!   the first step goes towards the target.
 //! * Steps: adapted to ~5 Newton iterations (`√(5/iterations)`, × ¼ … 2),
-//!   at most `max_step`; a step that fails is cut ÷4 down to `min_step`.
+//!   the load factor's change per step at most `max_step`; a step that
+//!   fails is cut ÷4 down to `min_step`.
 //! * Critical points ([`super::critical`]): a sign change of the load's
 //!   derivative along the path is a limit point, one of the lowest
 //!   eigenvalue without it a bifurcation; each is located between its two
@@ -175,6 +176,8 @@ pub(super) struct Follower<'a> {
     /// Compute the lowest eigenvalue at each point.
     pub stability: bool,
     pub record: Vec<NodeId>,
+    /// `|dλ/dp|` at the start: the scale of the load slope's noise.
+    pub start_slope: f64,
 }
 
 impl Follower<'_> {
@@ -374,9 +377,11 @@ impl StaticSolver {
             sense: 1.0,
             stability: settings.stability,
             record: spec.record.clone(),
+            start_slope: 0.0,
         };
         follower.sense = first_sense(&follower, spec, &tangent);
         let indicators = critical::indicators(&follower, &start, 0.0, &tangent, None);
+        follower.start_slope = indicators.load_slope.abs();
         let mut node = Node {
             state: start,
             lambda: 0.0,
@@ -449,10 +454,14 @@ impl StaticSolver {
                     break StaticTermination::Converged;
                 }
             }
+            // Iterations set the step; the load factor's change per step is
+            // capped (the displacement's is not: a buckled branch moves
+            // metres at a nearly constant load).
             let factor = (TARGET_ITERATIONS / step.iterations.max(1) as f64)
                 .sqrt()
                 .clamp(0.25, 2.0);
-            h = (h * factor).min(settings.max_step);
+            let d_lambda = step.d_lambda.abs() * factor;
+            h *= factor * (settings.max_step / d_lambda).min(1.0);
         };
         let solution = StaticSolution {
             load_factor: node.lambda,
