@@ -337,7 +337,8 @@ enum Command {
     Frame {
         /// The frame file (TOML).
         file: PathBuf,
-        /// Output JSON file [default: results/<file stem>/frame.json].
+        /// Output JSON file [default: results/<file stem>/frame.json]; the
+        /// path's frame-path.csv/.png/.svg are written beside it.
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -743,9 +744,9 @@ fn main() -> ExitCode {
             })
         }
         Command::Frame { file, output } => {
-            ringmesh::run::frame(file, output.as_deref()).map(|(o, path)| {
+            ringmesh::run::frame(file, output.as_deref()).map(|(o, paths)| {
                 say!("{}", frame_summary(&o));
-                say!("wrote {}", path.display());
+                say_written(&paths);
                 ended_early = o.ended_early();
             })
         }
@@ -870,7 +871,9 @@ fn section_line(t: &ringmesh::sizing::SectionTrial) -> String {
 fn frame_summary(o: &FrameOutput) -> String {
     let c = &o.counts;
     let ending = match o.termination {
-        StaticTermination::Converged => "converged at the full load".to_string(),
+        StaticTermination::Converged => {
+            format!("reached its target at load factor {:.6}", o.load_factor)
+        }
         StaticTermination::Stalled { load_factor } => {
             format!("STALLED: the load step fell below the minimum at load factor {load_factor:.6}")
         }
@@ -917,7 +920,22 @@ fn frame_summary(o: &FrameOutput) -> String {
         o.max_displacement_m,
         reaction,
         moment
-    )
+    ) + &o
+        .critical_points
+        .iter()
+        .map(|c| {
+            format!(
+                "\n  {} at load factor {:.9}{}",
+                json_name(&c.kind).replace('_', " "),
+                c.load_factor,
+                if c.switched_branch {
+                    " (followed its branch)"
+                } else {
+                    ""
+                }
+            )
+        })
+        .collect::<String>()
 }
 
 /// The cantilever table, one load per line.

@@ -9,9 +9,13 @@ use nalgebra::Vector3;
 
 use super::error::FrameFileError;
 use super::file::{FrameFile, NodeOrigin};
-use super::schema::{Component, RawFile, RawJointKind, RawMember, RawSection, Ref, RodEnd};
+use super::schema::{
+    Component, RawFile, RawJointKind, RawMember, RawOutput, RawPath, RawRecorded, RawSection, Ref,
+    RodEnd,
+};
 use crate::mechanics::{
-    JointKind, MechanicsError, Model, ModelBuilder, NodeId, Rod, RodSpec, Section,
+    JointKind, MechanicsError, Model, ModelBuilder, NodeId, PathSpec, PathTarget, Rod, RodSpec,
+    Section,
 };
 
 /// Most beam elements of one rod (a finer mesh buys nothing: 64 SE(3)
@@ -517,6 +521,7 @@ pub(super) fn build(raw: RawFile) -> Result<FrameFile, FrameFileError> {
         builder.add_load(node, force, moment);
     }
 
+    let (path, recorded_labels) = path_spec(&raw.path, &raw.output, &members)?;
     let model = builder.build()?;
     unsupported_member(&model, &joined, &supported_nodes, &members)?;
     let bodies = members
@@ -531,7 +536,119 @@ pub(super) fn build(raw: RawFile) -> Result<FrameFile, FrameFileError> {
         rods_labels: members.rods_labels,
         bodies,
         supported_nodes,
+        path,
+        recorded_labels,
     })
+}
+
+/// A member's label: the node's or body's name, `ROD.start`, `ROD.end`.
+fn member_label(m: &RawMember) -> String {
+    let label = match (&m.node, &m.rod, m.end, &m.body) {
+        (Some(n), ..) => n.to_string(),
+        (_, Some(r), Some(RodEnd::Start), _) => format!("{r}.start"),
+        (_, Some(r), _, _) => format!("{r}.end"),
+        (.., Some(b)) => b.to_string(),
+        _ => "member".into(),
+    };
+    label.replace('"', "")
+}
+
+/// `[path]` and `[output]`: the target (default: the full load), the
+/// controlled translation, the recorded nodes — each node a `[[nodes]]`
+/// reference resolved to the one rod end or body there.
+fn path_spec(
+    raw: &RawPath,
+    output: &RawOutput,
+    members: &Members,
+) -> Result<(PathSpec, Vec<String>), FrameFileError> {
+    let node_ref = |r: &Ref| RawMember {
+        node: Some(r.clone()),
+        rod: None,
+        end: None,
+        body: None,
+    };
+    let target = match &raw.target {
+        None => PathTarget::LoadFactor(1.0),
+        Some(t) => {
+            let key = "path.target";
+            let given = [
+                t.load_factor.is_some(),
+                t.on.is_some() || t.component.is_some() || t.displacement_m.is_some(),
+                t.steps.is_some(),
+            ];
+            if given.iter().filter(|&&g| g).count() != 1 {
+                return Err(FrameFileError::invalid(
+                    key,
+                    "give exactly one of `load_factor`, `node` with `component` and \
+                     `displacement_m`, or `steps`",
+                ));
+            }
+            if let Some(l) = t.load_factor {
+                if !(l.is_finite() && l != 0.0) {
+                    return Err(FrameFileError::invalid(
+                        format!("{key}.load_factor"),
+                        "must be a finite number other than 0 (the start)",
+                    ));
+                }
+                PathTarget::LoadFactor(l)
+            } else if let Some(n) = t.steps {
+                if n == 0 {
+                    return Err(FrameFileError::invalid(
+                        format!("{key}.steps"),
+                        "must be at least 1",
+                    ));
+                }
+                PathTarget::Steps(n)
+            } else {
+                let (Some(on), Some(component), Some(value_m)) =
+                    (&t.on, t.component, t.displacement_m)
+                else {
+                    return Err(FrameFileError::invalid(
+                        key,
+                        "a displacement target needs `on`, `component` and `displacement_m`",
+                    ));
+                };
+                if !(value_m.is_finite() && value_m != 0.0) {
+                    return Err(FrameFileError::invalid(
+                        format!("{key}.displacement_m"),
+                        "must be a finite number other than 0 (the start)",
+                    ));
+                }
+                PathTarget::Displacement {
+                    node: members.resolve(&format!("{key}.on"), on)?,
+                    component: component as usize,
+                    value_m,
+                }
+            }
+        }
+    };
+    let control = match &raw.control {
+        None => None,
+        Some(c) => Some((
+            members.resolve("path.control.on", &c.on)?,
+            c.component as usize,
+        )),
+    };
+    let mut record = Vec::with_capacity(output.nodes.len());
+    let mut labels = Vec::with_capacity(output.nodes.len());
+    for (i, r) in output.nodes.iter().enumerate() {
+        let key = format!("output.nodes[{i}]");
+        let (member, label) = match r {
+            RawRecorded::Node(Ref::Name(n)) => (node_ref(&Ref::Name(n.clone())), n.clone()),
+            RawRecorded::Node(Ref::Index(n)) => (node_ref(&Ref::Index(*n)), format!("nodes[{n}]")),
+            RawRecorded::Member(m) => (m.clone(), member_label(m)),
+        };
+        record.push(members.resolve(&key, &member)?);
+        labels.push(label);
+    }
+    Ok((
+        PathSpec {
+            target,
+            control,
+            record,
+        },
+        labels,
+    ))
 }
 
 /// Refuses a frame with a rod or body that no chain of elements and joints

@@ -4,7 +4,7 @@
 
 use std::fmt;
 
-use crate::mechanics::{Model, NodeId, Rod, StaticSettings};
+use crate::mechanics::{Model, NodeId, PathSpec, Rod, StaticSettings};
 
 /// What a node of the model is: a rod's node or a rigid body.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -47,6 +47,12 @@ pub struct FrameFile {
     pub bodies: Vec<(String, NodeId)>,
     /// Nodes with a support, in the order of `[[supports]]` (each once).
     pub supported_nodes: Vec<NodeId>,
+    /// The path to follow (`[path]`, `[output]`): its target, controlled
+    /// translation and recorded nodes.
+    pub path: PathSpec,
+    /// The recorded nodes' labels (as written in `[output] nodes`), in the
+    /// order of `path.record`.
+    pub recorded_labels: Vec<String>,
 }
 
 impl FrameFile {

@@ -45,6 +45,64 @@ pub(super) struct RawFile {
     pub(super) loads: Vec<RawLoad>,
     #[serde(default)]
     pub(super) solver: StaticSettings,
+    #[serde(default)]
+    pub(super) path: RawPath,
+    #[serde(default)]
+    pub(super) output: RawOutput,
+}
+
+/// A translation component.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub(super) enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+/// `[path]`: where the path ends and what drives displacement control.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPath {
+    pub(super) target: Option<RawTarget>,
+    pub(super) control: Option<RawControl>,
+}
+
+/// `target = { load_factor = … }`, `{ on = MEMBER, component = …,
+/// displacement_m = … }` or `{ steps = … }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTarget {
+    pub(super) load_factor: Option<f64>,
+    pub(super) on: Option<RawMember>,
+    pub(super) component: Option<Axis>,
+    pub(super) displacement_m: Option<f64>,
+    pub(super) steps: Option<usize>,
+}
+
+/// `control = { on = MEMBER, component = … }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawControl {
+    pub(super) on: RawMember,
+    pub(super) component: Axis,
+}
+
+/// A recorded node: a `[[nodes]]` reference (the one member there) or a
+/// member.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub(super) enum RawRecorded {
+    Node(Ref),
+    Member(RawMember),
+}
+
+/// `[output]`: the nodes whose displacements the path records.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawOutput {
+    #[serde(default)]
+    pub(super) nodes: Vec<RawRecorded>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -111,7 +169,7 @@ pub(super) enum RodEnd {
     End,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMember {
     pub(super) node: Option<Ref>,

@@ -286,6 +286,18 @@ pub(super) fn follow(
     lambda0: f64,
     settings: &StaticSettings,
 ) -> StaticSolution {
+    follow_observed(solver, start, lambda0, settings, &mut |_, _, _| {})
+}
+
+/// [`follow`], calling `observe(state, load factor, Newton iterations)` at
+/// every accepted step.
+pub(super) fn follow_observed(
+    solver: &StaticSolver,
+    start: State,
+    lambda0: f64,
+    settings: &StaticSettings,
+    observe: &mut dyn FnMut(&State, f64, usize),
+) -> StaticSolution {
     let clock = Instant::now();
     let w = solver.weights();
     let mut state = start;
@@ -334,6 +346,7 @@ pub(super) fn follow(
                 state = trial;
                 lambda = target;
                 reactions = run.reactions;
+                observe(&state, lambda, run.iterations);
                 if run.iterations <= 4 {
                     step = (2.0 * step).min(1.0);
                 } else if run.iterations > 10 {

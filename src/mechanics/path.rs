@@ -338,7 +338,9 @@ impl StaticSolver {
             })?;
         let psi = corrector.dot(&tangent, &tangent).sqrt();
         let control = match settings.path {
-            PathControl::Load => Control::Load,
+            PathControl::Load => {
+                return self.follow_load(spec, settings, tangent, corrector, clock);
+            }
             PathControl::ArcLength => Control::Arc { psi },
             PathControl::Displacement => {
                 let Some((node, component)) = spec.control else {
@@ -477,6 +479,70 @@ impl StaticSolver {
             solution,
             points: run.points,
             critical_points: run.critical_points,
+        })
+    }
+}
+
+impl StaticSolver {
+    /// [`StaticSolver::follow_path`] under load control: the load ramped to
+    /// λ = 1 by [`super::load_control`] (its branch tests end the path at a
+    /// limit load instead of snapping through), every accepted step
+    /// recorded. No critical point is located: the termination says where a
+    /// limit stopped it; arc length follows through and locates.
+    fn follow_load(
+        &self,
+        spec: &PathSpec,
+        settings: &StaticSettings,
+        tangent: Vec<f64>,
+        corrector: Corrector,
+        clock: Instant,
+    ) -> Result<PathSolution, MechanicsError> {
+        if spec.target != PathTarget::LoadFactor(1.0) {
+            return Err(MechanicsError::invalid(
+                "path.target",
+                "load control ends at the full load (load_factor = 1): follow another target \
+                 by arc length or displacement control",
+            ));
+        }
+        let follower = Follower {
+            corrector,
+            control: Control::Load,
+            sense: 1.0,
+            stability: settings.stability,
+            record: spec.record.clone(),
+            start_slope: 1.0,
+        };
+        let start = self.reference_state();
+        let indicators = critical::indicators(&follower, &start, 0.0, &tangent, None);
+        let at = |state: &State, lambda: f64| Node {
+            state: state.clone(),
+            lambda,
+            tangent: Vec::new(),
+            indicators: critical::indicators(&follower, state, lambda, &[], None),
+        };
+        let mut points = vec![follower.point(
+            &Node {
+                state: start.clone(),
+                lambda: 0.0,
+                tangent,
+                indicators,
+            },
+            0,
+        )];
+        let mut solution = super::load_control::follow_observed(
+            self,
+            start,
+            0.0,
+            settings,
+            &mut |state, lambda, iterations| {
+                points.push(follower.point(&at(state, lambda), iterations))
+            },
+        );
+        solution.time_s = clock.elapsed().as_secs_f64();
+        Ok(PathSolution {
+            solution,
+            points,
+            critical_points: Vec::new(),
         })
     }
 }

@@ -19,7 +19,8 @@ pub use csv::{
 };
 pub use output_set::{abandon_all_and_exit, check_manifest, FileRecord, OutputSet, RunRecord};
 pub use plot::{
-    aperture_plot, convergence_plot, front_plot, study_plot, surface_plot, NodePanel, SurfaceFigure,
+    aperture_plot, convergence_plot, front_plot, path_plot, study_plot, surface_plot, NodePanel,
+    PathFigure, SurfaceFigure,
 };
 pub use vtk::{assembly_vtu, network_vtu};
 

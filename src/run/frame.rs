@@ -7,9 +7,26 @@ use serde::Serialize;
 
 use crate::algebra::norm3;
 use crate::frame::{FrameFile, FrameFileError, NodeOrigin};
-use crate::mechanics::{rotation, MechanicsError, StaticSolver, StaticTermination, StepRecord};
-use crate::report::write_json;
+use crate::mechanics::{
+    rotation, CriticalPoint, MechanicsError, PathPoint, StaticSolver, StaticTermination, StepRecord,
+};
+use crate::report::{path_plot, readable, write_atomic, write_json, OutputSet, PathFigure};
 use crate::Error;
+
+/// The path files written beside the frame's JSON.
+const PATH_CSV: &str = "frame-path.csv";
+const PATH_PNG: &str = "frame-path.png";
+const PATH_SVG: &str = "frame-path.svg";
+
+/// The followed path in `ringmesh frame`'s output.
+#[derive(Debug, Clone, Serialize)]
+pub struct FramePath {
+    /// The recorded nodes (`[output] nodes`), in the order of each point's
+    /// displacements.
+    pub nodes: Vec<String>,
+    /// Every converged step, the unloaded frame first.
+    pub points: Vec<PathPoint>,
+}
 
 /// One node of `ringmesh frame`'s output.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -76,6 +93,11 @@ pub struct FrameOutput {
     pub reactions: Vec<FrameReaction>,
     /// Converged steps: load factor, Newton iterations, `‖F‖∞` per iteration.
     pub steps: Vec<StepRecord>,
+    /// The equilibrium path followed: each step's load factor, the
+    /// recorded nodes' displacements and the lowest eigenvalue.
+    pub path: FramePath,
+    /// Limit and bifurcation points located on the path, in path order.
+    pub critical_points: Vec<CriticalPoint>,
 }
 
 /// The size of a frame.
@@ -103,8 +125,8 @@ pub fn default_frame_output(frame_path: &Path) -> PathBuf {
 }
 
 impl FrameOutput {
-    /// Why the run ended before its target — the full load — or `None` when
-    /// it reached it. The CLI exits 3 then, after writing what it found.
+    /// Why the run ended before its target (by default the full load), or
+    /// `None` when it reached it. The CLI exits 3 then, after writing what it found.
     pub fn ended_early(&self) -> Option<String> {
         match self.termination {
             StaticTermination::Converged => None,
@@ -113,17 +135,30 @@ impl FrameOutput {
     }
 }
 
-/// `ringmesh frame`: reads a frame file, solves its statics and writes every
-/// node's position, displacement and rotation, the reactions and the solver's
-/// statistics as JSON (`output_path`, default [`default_frame_output`]).
-/// Not converging is a termination status in the output, not an error.
+/// `ringmesh frame`: reads a frame file, follows its equilibrium path to
+/// the target (`[path]`, by default the full load) and writes every node's
+/// position, displacement and rotation, the reactions, the solver's
+/// statistics and the path with its critical points as JSON
+/// (`output_path`, default [`default_frame_output`]), and beside it the path
+/// as `frame-path.csv` and `frame-path.png/.svg` (load factor against the
+/// first recorded node's displacement), all or none. Not reaching the target
+/// is a termination status in the output, not an error. Returns the output
+/// and the files written.
 pub fn frame(
     frame_path: &Path,
     output_path: Option<&Path>,
-) -> Result<(FrameOutput, PathBuf), Error> {
+) -> Result<(FrameOutput, Vec<PathBuf>), Error> {
     let file = FrameFile::read(frame_path)?;
     let output_path =
         output_path.map_or_else(|| default_frame_output(frame_path), Path::to_path_buf);
+    let dir = output_path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let json_name = output_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "frame.json".into());
     let counts = FrameCounts {
         nodes: file.model.node_count(),
         rods: file.model.rods().len(),
@@ -136,8 +171,12 @@ pub fn frame(
         "the factorised stiffness",
         crate::resources::frame_memory(counts.elements as u64),
     )?;
+    let set = OutputSet::begin(dir, &[json_name.as_str(), PATH_CSV, PATH_PNG, PATH_SVG])?;
     let solver = StaticSolver::new(file.model.clone()).map_err(FrameFileError::from)?;
-    let solution = solver.solve(&file.settings).map_err(FrameFileError::from)?;
+    let followed = solver
+        .follow_path(&file.path, &file.settings)
+        .map_err(FrameFileError::from)?;
+    let solution = followed.solution;
     let reference = file.model.reference();
     let nodes: Vec<FrameNodeOutput> = solution
         .state
@@ -208,7 +247,113 @@ pub fn frame(
         nodes,
         reactions,
         steps: solution.steps,
+        path: FramePath {
+            nodes: file.recorded_labels.clone(),
+            points: followed.points,
+        },
+        critical_points: followed.critical_points,
     };
-    write_json(&output_path, &output)?;
-    Ok((output, output_path))
+    let finite_path = output.path.points.iter().all(|p| {
+        p.load_factor.is_finite() && p.displacements_m.iter().flatten().all(|v| v.is_finite())
+    });
+    if !finite_path {
+        return Err(FrameFileError::from(MechanicsError::NotFinite {
+            detail: "a load factor or displacement on the path is not finite".into(),
+        })
+        .into());
+    }
+    write_atomic(&set.path(PATH_CSV), path_csv(&output).as_bytes())?;
+    path_plot(
+        &path_figure(&output),
+        &set.path(PATH_PNG),
+        &set.path(PATH_SVG),
+    )?;
+    write_json(&set.path(&json_name), &output)?;
+    Ok((output, set.commit()?))
+}
+
+/// `frame-path.csv`: one row per converged step (`kind` = `step`) and per
+/// critical point (its kind, after the step before it): load factor, the
+/// lowest eigenvalue, each recorded node's displacement.
+fn path_csv(output: &FrameOutput) -> String {
+    let mut csv = String::from("kind,step,load_factor,lowest_stiffness_n_per_m");
+    for n in &output.path.nodes {
+        for c in ["x", "y", "z"] {
+            csv.push_str(&format!(",{n}_u{c}_m"));
+        }
+    }
+    csv.push('\n');
+    let row = |kind: &str, step: usize, lambda: f64, lowest: Option<f64>, u: &[[f64; 3]]| {
+        let mut line = format!(
+            "{kind},{step},{},{}",
+            readable(lambda, 13),
+            lowest.map_or(String::new(), |v| readable(v, 7))
+        );
+        for v in u.iter().flatten() {
+            line.push(',');
+            line.push_str(&readable(*v, 13));
+        }
+        line.push('\n');
+        line
+    };
+    for (i, p) in output.path.points.iter().enumerate() {
+        csv.push_str(&row(
+            "step",
+            i,
+            p.load_factor,
+            p.lowest_stiffness_n_per_m,
+            &p.displacements_m,
+        ));
+        for c in output.critical_points.iter().filter(|c| c.after_point == i) {
+            csv.push_str(&row(
+                crate::report::json_name(&c.kind).as_str(),
+                i,
+                c.load_factor,
+                c.lowest_stiffness_n_per_m,
+                &c.displacements_m,
+            ));
+        }
+    }
+    csv
+}
+
+/// The path plot: load factor against the first recorded node's
+/// displacement component that moves most (the step number without one).
+fn path_figure(output: &FrameOutput) -> PathFigure {
+    let points = &output.path.points;
+    let component = (0..3)
+        .max_by(|&a, &b| {
+            let range = |c: usize| {
+                let v = points
+                    .iter()
+                    .filter_map(|p| p.displacements_m.first().map(|u| u[c]));
+                v.clone().fold(f64::MIN, f64::max) - v.fold(f64::MAX, f64::min)
+            };
+            range(a).total_cmp(&range(b))
+        })
+        .unwrap_or(0);
+    let x = |u: &[[f64; 3]], step: usize| u.first().map_or(step as f64, |u| u[component]);
+    let x_label = output.path.nodes.first().map_or("step".to_string(), |n| {
+        format!("{n}: displacement {} (m)", ["x", "y", "z"][component])
+    });
+    PathFigure {
+        title: format!("equilibrium path of {}", output.file),
+        x_label,
+        points: points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (x(&p.displacements_m, i), p.load_factor))
+            .collect(),
+        critical: output
+            .critical_points
+            .iter()
+            .map(|c| {
+                (
+                    x(&c.displacements_m, c.after_point),
+                    c.load_factor,
+                    crate::report::json_name(&c.kind),
+                )
+            })
+            .collect(),
+    }
 }
