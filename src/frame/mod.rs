@@ -51,7 +51,23 @@
 //!   `moment_nm` (global, fixed in direction; each defaults to zero).
 //! * `[solver]` — [`StaticSettings`](crate::mechanics::StaticSettings):
 //!   `tolerance`, `max_iterations`, `initial_step`, `min_step`, `max_steps`,
-//!   `path = "load" | "arc_length"`.
+//!   `path = "load" | "arc_length" | "displacement"`; for path following
+//!   (arc length, displacement control) `max_step` (the largest change of
+//!   the load factor per step, default 0.1), `stability` (the lowest
+//!   eigenvalue at every step and bifurcations located, default true),
+//!   `branch_switch` (leave the path for the branch of the first
+//!   bifurcation, default false).
+//! * `[path]` — where the path ends, `target = { load_factor = 1.0 }` (the
+//!   default), `{ on = MEMBER, component = "x" | "y" | "z", displacement_m
+//!   = … }` or `{ steps = N }`; `control = { on = MEMBER, component = … }`,
+//!   the translation `path = "displacement"` drives. Load control ends at
+//!   the full load (or a limit point); arc length follows the path through
+//!   limit points in load and displacement, across λ ≤ 0 and back.
+//! * `[output]` — `nodes = ["tip", { rod = "beam", end = "end" }, …]`: the
+//!   `[[nodes]]` (the one member there) or members whose displacements every
+//!   step of the path records (`frame.json`'s `path`, `frame-path.csv`,
+//!   `frame-path.png/.svg` — the load factor against the first one's
+//!   displacement).
 //!
 //! # Example
 //!

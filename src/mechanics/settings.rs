@@ -155,8 +155,8 @@ impl StaticSettings {
         if self.max_steps == 0 {
             return bad("max_steps", "must be at least 1");
         }
-        if !(self.max_step >= self.min_step && self.max_step <= 1e6) {
-            return bad("max_step", "must be in [min_step, 1e6]");
+        if !(self.max_step > 0.0 && self.max_step <= 1e6) {
+            return bad("max_step", "must be in (0, 1e6]");
         }
         Ok(())
     }
