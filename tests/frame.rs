@@ -280,9 +280,28 @@ fn frame_command_writes_positions_rotations_reactions_and_solver_stats() {
         String::from_utf8_lossy(&run.stderr)
     );
     let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(stdout.contains("converged at the full load"), "{stdout}");
+    assert!(
+        stdout.contains("reached its target at load factor 1.000000"),
+        "{stdout}"
+    );
     let json: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(json["termination"]["status"], "converged");
+    // The path: the unloaded frame and every load step, and its files.
+    let points = json["path"]["points"].as_array().unwrap();
+    assert_eq!(
+        points.len() as u64,
+        json["load_steps"].as_u64().unwrap() + 1
+    );
+    assert_eq!(points[0]["load_factor"], 0.0);
+    assert_eq!(points.last().unwrap()["load_factor"], 1.0);
+    let csv = std::fs::read_to_string(out.with_file_name("frame-path.csv")).unwrap();
+    assert_eq!(csv.lines().count(), points.len() + 1, "{csv}");
+    for plot in ["frame-path.png", "frame-path.svg"] {
+        assert!(
+            out.with_file_name(plot).metadata().unwrap().len() > 0,
+            "{plot}"
+        );
+    }
     assert_eq!(json["load_factor"], 1.0);
     for key in ["load_steps", "newton_iterations", "rejected_steps"] {
         assert!(json[key].is_u64(), "{key}");

@@ -10,12 +10,12 @@ use nalgebra::Vector3;
 use super::error::FrameFileError;
 use super::file::{FrameFile, NodeOrigin};
 use super::schema::{
-    Component, RawFile, RawJointKind, RawMember, RawOutput, RawPath, RawRecorded, RawSection, Ref,
-    RodEnd,
+    Component, RawArc, RawFile, RawJointKind, RawMember, RawOutput, RawPath, RawRecorded,
+    RawSection, Ref, RodEnd,
 };
 use crate::mechanics::{
-    JointKind, MechanicsError, Model, ModelBuilder, NodeId, PathSpec, PathTarget, Rod, RodSpec,
-    Section,
+    CircularArc, JointKind, MechanicsError, Model, ModelBuilder, NodeId, PathSpec, PathTarget, Rod,
+    RodSpec, Section, MAX_ELEMENT_ANGLE_RAD,
 };
 
 /// Most beam elements of one rod (a finer mesh buys nothing: 64 SE(3)
@@ -204,6 +204,69 @@ impl Names {
     }
 }
 
+/// The circular arc of rod `key` (`rods[i]`) from `p` to `q`, checked with
+/// the key at fault named: `centre_m` (with an optional `normal`) or
+/// `through_m`, the ends on one circle, the normal across its plane, and
+/// enough `elements` to span it at [`MAX_ELEMENT_ANGLE_RAD`] each.
+fn arc(
+    key: &str,
+    raw: &RawArc,
+    p: Vector3<f64>,
+    q: Vector3<f64>,
+    elements: usize,
+) -> Result<CircularArc, FrameFileError> {
+    let arc_key = format!("{key}.arc");
+    let arc = match (raw.centre_m, raw.through_m) {
+        (Some(centre), None) => CircularArc::Centre {
+            centre_m: vector(&format!("{arc_key}.centre_m"), centre)?,
+            normal: match raw.normal {
+                Some(n) => Some(nonzero(&format!("{arc_key}.normal"), n)?),
+                None => None,
+            },
+        },
+        (None, Some(through)) => {
+            if raw.normal.is_some() {
+                return Err(FrameFileError::invalid(
+                    format!("{arc_key}.normal"),
+                    "the circle through the start, `through_m` and the end has its own \
+                     normal: give `normal` only with `centre_m`",
+                ));
+            }
+            CircularArc::Through {
+                through_m: vector(&format!("{arc_key}.through_m"), through)?,
+            }
+        }
+        (Some(_), Some(_)) => {
+            return Err(FrameFileError::invalid(
+                arc_key,
+                "give either `centre_m` (with an optional `normal`) or `through_m`, not both",
+            ))
+        }
+        (None, None) => {
+            return Err(FrameFileError::invalid(
+                arc_key,
+                "missing: `centre_m` (with an optional `normal`) or `through_m`",
+            ))
+        }
+    };
+    let geometry = arc
+        .geometry(p, q)
+        .map_err(|e| FrameFileError::invalid(format!("{arc_key}.{}", e.input.name()), e.reason))?;
+    let fewest = geometry.fewest_elements();
+    if elements < fewest {
+        return Err(FrameFileError::invalid(
+            format!("{key}.elements"),
+            format!(
+                "{elements} is too few for an arc of {:.1}°: at least {fewest} (at most {:.0}° \
+                 an element)",
+                geometry.angle_rad.to_degrees(),
+                MAX_ELEMENT_ANGLE_RAD.to_degrees()
+            ),
+        ));
+    }
+    Ok(arc)
+}
+
 /// Where rods and bodies are, to resolve members.
 struct Members {
     nodes: Names,
@@ -335,8 +398,14 @@ pub(super) fn build(raw: RawFile) -> Result<FrameFile, FrameFileError> {
             return Err(FrameFileError::invalid(
                 format!("{key}.end"),
                 format!(
-                    "node {} is where the rod starts (node {}): zero length",
-                    r.end, r.start
+                    "node {} is where the rod starts (node {}): zero length{}",
+                    r.end,
+                    r.start,
+                    if r.arc.is_some() {
+                        " (a closed circle is two arcs, joined)"
+                    } else {
+                        ""
+                    }
                 ),
             ));
         }
@@ -412,7 +481,13 @@ pub(super) fn build(raw: RawFile) -> Result<FrameFile, FrameFileError> {
             elements: r.elements,
             kind: r.element,
         };
-        let rod = builder.add_rod(p, q, up, &spec);
+        let rod = match &r.arc {
+            Some(raw) => {
+                let arc = arc(&key, raw, p, q, r.elements)?;
+                builder.add_arc_rod(p, q, &arc, up, &spec)
+            }
+            None => builder.add_rod(p, q, up, &spec),
+        };
         origins.extend((0..rod.nodes.len()).map(|index| NodeOrigin::Rod {
             rod: label.clone(),
             index,

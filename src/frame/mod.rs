@@ -28,13 +28,28 @@
 //!   [`Section::tube`](crate::mechanics::Section::tube)) or the four
 //!   stiffnesses directly: `axial_n` (EA), `shear_n = [GA₂, GA₃]`,
 //!   `torsion_nm2` (GJ), `bending_nm2 = [EI₂, EI₃]`.
-//! * `[[rods]]` — straight rods from node `start` to node `end`; the section is
+//! * `[[rods]]` — rods from node `start` to node `end`, straight or along a
+//!   circular arc (`arc`, below); the section is
 //!   either `section = "NAME"`, or `tube = { … }`, or the four stiffnesses
 //!   written on the rod. `elements` (default 1), `element = "se3"` (default) or
 //!   `"crisfield-jelenic"`, optional `up` (the second axis of the section is the
 //!   one closest to `up`; default `[0, 0, 1]`), optional `name`. Every rod is
 //!   meshed with nodes of its own: its ends are connected to anything else only
 //!   by joints.
+//! * `arc` on a rod — the rod follows a circular arc from `start` to `end`:
+//!   `arc = { centre_m = [x, y, z] }`, the shorter arc about that centre;
+//!   `arc = { centre_m = [x, y, z], normal = [nx, ny, nz] }`, the arc turning
+//!   from start to end about `normal` (right-hand rule: `normal = [0, 0, -1]`
+//!   goes clockwise seen from +z, the long way if that is longer), which a
+//!   half circle needs (its start, centre and end are on one line); or
+//!   `arc = { through_m = [x, y, z] }`, the circle through start, that point
+//!   and end, from start via that point to end. Both ends must be at one
+//!   distance from the centre and the normal across the arc's plane, to 1e-9
+//!   relative. The nodes are equally spaced in angle, at most 90° apart
+//!   (`elements ≥ 2` for a half circle), each node's frame the start's turned
+//!   about the normal ([`CircularArc`](crate::mechanics::CircularArc)): the
+//!   elements have the exact initial curvature `1/R`, not chords, and their
+//!   arc lengths. `up` holds at the start and is carried along the arc.
 //! * `[[bodies]]` — rigid bodies (hinges, paper §3.3) at a node (`at = "h0"`) or
 //!   a point (`at_m = [x, y, z]`), optional `name`.
 //! * Members: the things joints, supports and loads act on, written
@@ -161,6 +176,59 @@
 //! [solver]
 //! tolerance = 1e-10
 //! path = "load"
+//! ```
+//!
+//! A semicircular arch of radius 2 m in the x–z plane, clamped at both feet:
+//! two quarter circles, one given by its centre and one by a point it passes
+//! through, fixed to each other at the crown, which carries a load.
+//!
+//! ```toml
+//! [[nodes]]
+//! name = "left"
+//! position_m = [-2.0, 0.0, 0.0]
+//! [[nodes]]
+//! name = "crown"
+//! position_m = [0.0, 0.0, 2.0]
+//! [[nodes]]
+//! name = "right"
+//! position_m = [2.0, 0.0, 0.0]
+//!
+//! [sections.steel]
+//! tube = { outer_diameter_m = 0.1, inner_diameter_m = 0.09, youngs_modulus_pa = 2.1e11, shear_modulus_pa = 8.1e10 }
+//!
+//! [[rods]]
+//! name = "west"
+//! start = "left"
+//! end = "crown"
+//! section = "steel"
+//! elements = 4
+//! up = [0.0, 1.0, 0.0]
+//! arc = { centre_m = [0.0, 0.0, 0.0] }
+//!
+//! [[rods]]
+//! name = "east"
+//! start = "crown"
+//! end = "right"
+//! section = "steel"
+//! elements = 4
+//! up = [0.0, 1.0, 0.0]
+//! arc = { through_m = [1.2, 0.0, 1.6] }
+//!
+//! [[joints]]
+//! kind = "fixed"
+//! a = { rod = "west", end = "end" }
+//! b = { rod = "east", end = "start" }
+//!
+//! [[supports]]
+//! on = { node = "left" }
+//! fixed = ["all"]
+//! [[supports]]
+//! on = { node = "right" }
+//! fixed = ["all"]
+//!
+//! [[loads]]
+//! on = { rod = "west", end = "end" }
+//! force_n = [0.0, 0.0, -1000.0]
 //! ```
 
 mod build;

@@ -148,6 +148,16 @@ pub(super) struct RawRod {
     #[serde(default)]
     pub(super) element: ElementKind,
     pub(super) up: Option<[f64; 3]>,
+    pub(super) arc: Option<RawArc>,
+}
+
+/// A rod's circular arc: `centre_m` (with an optional `normal`) or `through_m`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawArc {
+    pub(super) centre_m: Option<[f64; 3]>,
+    pub(super) normal: Option<[f64; 3]>,
+    pub(super) through_m: Option<[f64; 3]>,
 }
 
 fn one() -> usize {

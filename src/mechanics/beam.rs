@@ -140,6 +140,8 @@ impl Section {
 pub(crate) struct BeamElement {
     pub kind: ElementKind,
     pub nodes: [usize; 2],
+    /// `L`: the chord of a straight element, the arc length of a curved one
+    /// ([`reference_length_m`]).
     pub length_m: f64,
     stiffness: [f64; 6],
     /// Strains of the reference configuration (`Γ₀`, `K₀`, or `d₀/L`).
@@ -203,6 +205,30 @@ fn strains<S: DualNum<f64> + Copy>(
     ]
 }
 
+/// The element's length `L`, which scales its strains (`ε = d/L`) and its
+/// energy (`W = (L/2) εᵀ C ε`): the arc length of the helix joining its two
+/// reference frames, `|U|` with `U = V⁻¹(Ω) t` the translational part of the
+/// SE(3) logarithm `d₀ = log(H_A⁻¹ H_B)` (Sonneville, Cardona, Brüls 2014).
+///
+/// For a straight element (`Ω = 0`, `V⁻¹ = I`) it is the chord `|x_B − x_A|`,
+/// taken from the positions directly so that a straight rod is meshed to the
+/// same bits as before curved rods existed. For an element of a circular arc
+/// of radius `R` spanning `Δφ` (frames tangent to the arc) `U = (R Δφ, 0, 0)`:
+/// the arc length, not the chord `2R sin(Δφ/2)`, so that the reference
+/// curvature `Ω/L` is exactly `1/R` and a moment `M` adds `M/EI` to it. Both
+/// kinds take this length: the SE(3) element's centreline is that helix; the
+/// Crisfield–Jelenić element's is the chord, but its curvature `K = Ω/L` and
+/// its energy integral are the rod's only with the rod's length (with the
+/// chord, a curved element would be stiffer in bending by `R Δφ / chord`).
+fn reference_length_m(frames: [&Frame; 2], rel: &Relative) -> f64 {
+    if frames[0].rotation == frames[1].rotation {
+        return (frames[1].position_m - frames[0].position_m).norm();
+    }
+    let omega = log_generic(&rel.q);
+    let u = mat_vec(&left_jacobian_inverse_generic(&omega), &rel.t);
+    (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
+}
+
 /// A second-order dual number in the three rotation variables `φ`.
 type D3 = Dual2SVec64<3>;
 
@@ -219,8 +245,8 @@ impl BeamElement {
         frames: [&Frame; 2],
         section: &Section,
     ) -> Self {
-        let length_m = (frames[1].position_m - frames[0].position_m).norm();
         let rel = Relative::of(frames);
+        let length_m = reference_length_m(frames, &rel);
         let reference_strain = strains(kind, length_m, &rel.q, &rel.t);
         BeamElement {
             kind,
@@ -532,6 +558,45 @@ mod tests {
             "relative-frame route vs direct: residual {:e}, tangent {:e}",
             worst.0, worst.1
         );
+    }
+
+    #[test]
+    fn an_element_of_a_circular_arc_takes_its_arc_length_and_is_stress_free() {
+        // Frames tangent to a circle of radius 1.5 m, 0.3 rad … π/2 apart (a
+        // quarter turn, where cos θ may round to 0), in a tilted plane:
+        // L = R Δφ, not the chord 2R sin(Δφ/2), and no force at the
+        // reference.
+        let radius = 1.5;
+        let normal = Vector3::new(0.2, -0.3, 0.9).normalize();
+        let start = crate::mechanics::rotation::rod_frame(
+            &normal.cross(&Vector3::x()),
+            &Vector3::new(0.0, 1.0, 1.0),
+        );
+        let radial = (start * Vector3::x()).cross(&normal) * radius;
+        let at = |phi: f64| {
+            let turn = exp(&(normal * phi));
+            Frame {
+                position_m: turn * radial,
+                rotation: turn * start,
+            }
+        };
+        for span in [0.3, 1.0, std::f64::consts::FRAC_PI_2] {
+            let (a, b) = (at(0.0), at(span));
+            for kind in [ElementKind::Se3, ElementKind::CrisfieldJelenic] {
+                let e = BeamElement::new(kind, [0, 1], [&a, &b], &section());
+                assert!(
+                    (e.length_m - radius * span).abs() < 1e-14,
+                    "{kind:?} {span}: {} vs {}",
+                    e.length_m,
+                    radius * span
+                );
+                let (r, k) = e.residual_tangent([&a, &b]);
+                assert!(
+                    r.amax() < 1e-9 && k.iter().all(|v| v.is_finite()),
+                    "{kind:?} {span}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -7,6 +7,8 @@
 //!
 //! * [`rotation`] — SO(3): exponential, logarithm, tangent operator (eq. 7–14),
 //!   and the material frame of a rod; `node` — a node's id and configuration;
+//!   `circular_arc` — the reference geometry of a curved rod and its nodes'
+//!   frames;
 //! * `beam` — the 2-node beam elements: Crisfield–Jelenić (eq. 17–21) and
 //!   SE(3); `cable` — tension-only cables; `joint` — fixed, revolute and
 //!   spherical joints as constraints (eq. 22–25);
@@ -33,6 +35,7 @@ mod arc_length;
 mod assembly;
 mod beam;
 mod cable;
+mod circular_arc;
 mod condensed;
 mod corrector;
 mod critical;
@@ -52,6 +55,9 @@ pub(crate) use assembly::constraint_scale;
 pub use assembly::State;
 pub use beam::{ElementKind, Section};
 pub use cable::{Cable, CableState};
+pub use circular_arc::{
+    ArcError, ArcGeometry, ArcInput, CircularArc, ARC_TOLERANCE, MAX_ELEMENT_ANGLE_RAD,
+};
 pub use joint::JointKind;
 pub use limit::{limit_load_factor, LimitBound, LimitSearch};
 pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, Rod, RodSpec};

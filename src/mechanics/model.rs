@@ -9,6 +9,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use super::beam::{BeamElement, ElementKind, Section};
 use super::cable::Cable;
+use super::circular_arc::{CircularArc, MAX_ELEMENT_ANGLE_RAD};
 use super::joint::{Joint, JointKind};
 use super::node::{Frame, NodeId};
 use super::rotation::rod_frame;
@@ -321,16 +322,7 @@ impl ModelBuilder {
         let item = format!("rod {}", self.rods.len());
         let axis = end_m - start_m;
         let length = axis.norm();
-        if spec.elements == 0 {
-            self.errors
-                .push(MechanicsError::invalid(&item, "needs at least one element"));
-        }
-        if let Some(field) = spec.section.invalid_field() {
-            self.errors.push(MechanicsError::invalid(
-                &item,
-                format!("section stiffness {field} must be finite and positive"),
-            ));
-        }
+        self.check_spec(&item, spec);
         if !(length.is_finite() && length > 0.0) {
             self.errors.push(MechanicsError::invalid(
                 &item,
@@ -351,6 +343,81 @@ impl ModelBuilder {
                 self.add_frame(start_m + axis * s, rotation)
             })
             .collect();
+        self.mesh(nodes, spec)
+    }
+
+    /// A rod along a circular arc from `start_m` to `end_m` ([`CircularArc`]:
+    /// about a centre, or through a point), meshed into `spec.elements`
+    /// elements with their own nodes, equally spaced in angle, each node's
+    /// frame the start's turned about the arc's normal by its angle
+    /// ([`frames`](super::ArcGeometry::frames)): every element has the same
+    /// reference curvature `1/R`, exactly (the SE(3) element between two such
+    /// frames is the arc), and its length is its arc length, not its chord.
+    /// The material frame has its first axis along the tangent and, at the
+    /// start, its second axis as close to `up` as possible; along the arc it
+    /// turns with the tangent.
+    ///
+    /// An invalid arc, or too few elements to span it at
+    /// [`MAX_ELEMENT_ANGLE_RAD`] each, is an error of [`ModelBuilder::build`]
+    /// naming the rod.
+    pub fn add_arc_rod(
+        &mut self,
+        start_m: Vector3<f64>,
+        end_m: Vector3<f64>,
+        arc: &CircularArc,
+        up: Vector3<f64>,
+        spec: &RodSpec,
+    ) -> Rod {
+        let item = format!("rod {}", self.rods.len());
+        self.check_spec(&item, spec);
+        let geometry = if start_m.iter().chain(end_m.iter()).all(|c| c.is_finite()) {
+            arc.geometry(start_m, end_m).map_err(|e| format!("arc {e}"))
+        } else {
+            Err("its start or end is not finite".to_string())
+        };
+        let geometry = match geometry {
+            Ok(g) => g,
+            Err(reason) => {
+                self.errors.push(MechanicsError::invalid(&item, reason));
+                self.rods.push(Rod { nodes: vec![] });
+                return self.rods.last().cloned().expect("just pushed");
+            }
+        };
+        let fewest = geometry.fewest_elements();
+        if (1..fewest).contains(&spec.elements) {
+            self.errors.push(MechanicsError::invalid(
+                &item,
+                format!(
+                    "its arc of {:.1}° needs at least {fewest} elements (at most {:.0}° each)",
+                    geometry.angle_rad.to_degrees(),
+                    MAX_ELEMENT_ANGLE_RAD.to_degrees()
+                ),
+            ));
+        }
+        let nodes: Vec<NodeId> = geometry
+            .frames(&up, spec.elements.max(fewest))
+            .into_iter()
+            .map(|f| self.add_frame(f.position_m, f.rotation))
+            .collect();
+        self.mesh(nodes, spec)
+    }
+
+    /// The errors of a rod's mesh and section.
+    fn check_spec(&mut self, item: &str, spec: &RodSpec) {
+        if spec.elements == 0 {
+            self.errors
+                .push(MechanicsError::invalid(item, "needs at least one element"));
+        }
+        if let Some(field) = spec.section.invalid_field() {
+            self.errors.push(MechanicsError::invalid(
+                item,
+                format!("section stiffness {field} must be finite and positive"),
+            ));
+        }
+    }
+
+    /// The elements between consecutive `nodes` of a rod, and the rod.
+    fn mesh(&mut self, nodes: Vec<NodeId>, spec: &RodSpec) -> Rod {
         for w in nodes.windows(2) {
             let (a, b) = (w[0], w[1]);
             let element = BeamElement::new(
@@ -425,7 +492,8 @@ impl ModelBuilder {
     /// Validate and build.
     ///
     /// # Errors
-    /// The first invalid item, named: a zero-length rod, a joint on a missing
+    /// The first invalid item, named: a zero-length rod, an arc whose ends
+    /// are not on one circle (or too few elements for it), a joint on a missing
     /// node or between a node and itself, a rotational joint on a point, a
     /// load on a missing node.
     pub fn build(mut self) -> Result<Model, MechanicsError> {

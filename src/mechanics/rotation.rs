@@ -225,7 +225,16 @@ pub(crate) fn log_generic<S: DualNum<f64> + Copy>(r: &M3<S>) -> V3<S> {
             + s2 * s2 * s2 * s2 * (35.0 / 1152.0)
     } else {
         let sn = s2.sqrt();
-        sn.atan2(c) / sn
+        // num_dual's atan2 is atan(y/x) with the value put right: at x = 0
+        // exactly (θ = π/2, which the reference of a quarter-circle element
+        // meets) its derivatives are 0/0. There, the same function as
+        // π/2 − atan(x/y), y = |s| = 1; elsewhere atan2 as it always was.
+        let angle = if c.re() == 0.0 {
+            S::from(std::f64::consts::FRAC_PI_2) - (c / sn).atan()
+        } else {
+            sn.atan2(c)
+        };
+        angle / sn
     };
     scale(&s, factor)
 }
@@ -267,6 +276,48 @@ mod tests {
                 (back - theta).norm() < 1e-13 * angle.max(1e-3),
                 "log at {angle}"
             );
+        }
+    }
+
+    #[test]
+    fn generic_log_is_differentiable_at_a_quarter_turn() {
+        // A quarter turn about y whose trace is exactly 1 (cos θ = 0, where
+        // atan2 of dual numbers divides by zero): the gradient and Hessian of
+        // a component mix of log(R exp(p̃)) at p = 0 are finite and match
+        // central differences of the f64 logarithm.
+        use nalgebra::SVector;
+        use num_dual::{hessian, Dual2SVec64};
+        let r = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]];
+        let weights = [0.3, -0.5, 0.8];
+        fn mix<S: DualNum<f64> + Copy>(r: &M3<f64>, w: &[f64; 3], e: &M3<S>) -> S {
+            let q: M3<S> = std::array::from_fn(|i| {
+                std::array::from_fn(|j| e[0][j] * r[i][0] + e[1][j] * r[i][1] + e[2][j] * r[i][2])
+            });
+            let l = log_generic(&q);
+            l[0] * w[0] + l[1] * w[1] + l[2] * w[2]
+        }
+        let (_, g, h) = hessian(
+            |p: SVector<Dual2SVec64<3>, 3>| {
+                mix(&r, &weights, &exp_second_order(&[p[0], p[1], p[2]]))
+            },
+            SVector::<f64, 3>::zeros(),
+        );
+        let at = |p: Vector3<f64>| mix(&r, &weights, &exp_generic(&lift_v(&p)));
+        let unit = |i: usize| Vector3::from_fn(|k, _| if k == i { 1.0 } else { 0.0 });
+        for i in 0..3 {
+            let d = 1e-6;
+            let fd = (at(unit(i) * d) - at(-unit(i) * d)) / (2.0 * d);
+            assert!((g[i] - fd).abs() < 1e-9, "gradient {i}: {} vs {fd}", g[i]);
+            for j in 0..3 {
+                let d = 1e-4;
+                let (a, b) = (unit(i) * d, unit(j) * d);
+                let fd = (at(a + b) - at(a - b) - at(b - a) + at(-a - b)) / (4.0 * d * d);
+                assert!(
+                    (h[(i, j)] - fd).abs() < 1e-6,
+                    "Hessian {i}{j}: {} vs {fd}",
+                    h[(i, j)]
+                );
+            }
         }
     }
 
