@@ -326,7 +326,7 @@ impl StaticSolver {
         if let PathTarget::Steps(0) = spec.target {
             return bad("path.target", "must be at least one step".into());
         }
-        if !(self.load_scale() > 0.0) {
+        if self.load_scale() <= 0.0 {
             return bad("loads", "there are no loads to follow".into());
         }
         let corrector = Corrector::new(self, settings);
