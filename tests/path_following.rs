@@ -6,8 +6,8 @@
 mod common;
 
 use common::frames::{
-    euler_column, von_mises, von_mises_limit, von_mises_load, ColumnEnds, COLUMN_EI_NM2,
-    COLUMN_LENGTH_M, VM_RISE_M,
+    euler_column, quarter_ring, von_mises, von_mises_limit, von_mises_load, ColumnEnds,
+    COLUMN_EI_NM2, COLUMN_LENGTH_M, RING_EI_NM2, RING_RADIUS_M, VM_RISE_M,
 };
 use ringmesh::mechanics::{
     CriticalKind, PathControl, PathSolution, PathSpec, PathTarget, StaticSettings,
@@ -318,4 +318,69 @@ fn branch_switching_follows_the_elastica_of_a_buckled_column() {
         switched[0].load_factor,
         path.points.len() - after - 1
     );
+}
+
+#[test]
+fn a_ring_under_radial_dead_loads_buckles_at_four_ei_over_r_cubed() {
+    // Uniform radial loads that keep their direction: the ring's oval mode
+    // (n = 2) is critical at q = n²EI/R³ = 4EI/R³ — the inextensible ring's
+    // bending energy EI/(2R³)∫(w″ + w)² against the dead load's second-order
+    // work q/2 ∫(w′ − v)², v′ = −w, for w = cos nθ (Timoshenko & Gere §7.5
+    // give (n² − 1)EI/R³ for pressure that follows the ring; dead loads
+    // add the q/n² of the load's own rotation). Followed past it by arc
+    // length, on quarter rings of 4, 8, 16 arc elements.
+    let exact = 4.0 * RING_EI_NM2 / RING_RADIUS_M.powi(3);
+    let applied = 1.25 * exact;
+    let mut errors = Vec::new();
+    for elements in [4, 8, 16] {
+        let (solver, nodes) = quarter_ring(elements, applied);
+        let spec = PathSpec {
+            target: PathTarget::LoadFactor(1.0),
+            control: None,
+            record: vec![nodes[0]],
+        };
+        let settings = StaticSettings {
+            path: PathControl::ArcLength,
+            ..StaticSettings::default()
+        };
+        let path = solver.follow_path(&spec, &settings).unwrap();
+        assert_eq!(path.solution.termination, StaticTermination::Converged);
+        let [b] = path.critical_points.as_slice() else {
+            panic!("{elements} elements: {:?}", path.critical_points);
+        };
+        assert_eq!(b.kind, CriticalKind::Bifurcation);
+        let q = b.load_factor * applied;
+        // The mode is the oval cos 2θ: radial deflection at each node.
+        let reference = solver.model().reference();
+        let mode = b.mode.translations_m();
+        let radial: Vec<(f64, f64)> = nodes
+            .iter()
+            .map(|&n| {
+                let p = reference[n].position_m;
+                let theta = p.y.atan2(p.x);
+                let t = mode[n];
+                (theta, t[0] * theta.cos() + t[1] * theta.sin())
+            })
+            .collect();
+        let scale = radial[0].1;
+        let misfit = radial
+            .iter()
+            .map(|&(theta, w)| (w / scale - (2.0 * theta).cos()).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            misfit <= 0.05,
+            "{elements} elements: oval mode misfit {misfit}"
+        );
+        errors.push((q - exact) / exact);
+        eprintln!(
+            "ring, {elements} arc elements per quarter: q_cr {q:.9} N/m ({:+.3e} of 4EI/R³), mode misfit {misfit:.2e}",
+            (q - exact) / exact
+        );
+    }
+    // h²: ×4 per halving (measured: 5.27e-2, 1.29e-2, 3.22e-3).
+    for w in errors.windows(2) {
+        let rate = w[0] / w[1];
+        assert!((3.5..4.5).contains(&rate), "errors {errors:?}");
+    }
+    assert!(errors[2].abs() <= 5e-3, "errors {errors:?}");
 }

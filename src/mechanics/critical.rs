@@ -22,8 +22,9 @@
 //! crosses the path transversally there, in the direction of the mode).
 
 use super::corrector::{Constraint, Corrected};
-use super::path::{Control, CriticalKind, CriticalPoint, Follower, Node, PathTarget, Run};
-use super::stability::{lowest_eigenpair, translations};
+use super::follower::{Control, Follower, Node, Run};
+use super::path_spec::{CriticalKind, CriticalPoint, PathTarget};
+use super::stability::translations;
 
 /// Largest number of re-solved fractions in one location.
 const MAX_LOCATE: usize = 80;
@@ -46,50 +47,6 @@ const SLOPE_NOISE: f64 = 1e-6;
 /// Attempts, each with a step a quarter of the last, to leave a
 /// bifurcation point along its mode.
 const SWITCH_ATTEMPTS: usize = 4;
-
-/// What the critical points are detected by, at one converged point.
-#[derive(Debug, Clone, Default)]
-pub(super) struct Indicators {
-    /// The load's derivative along the path (per unit arc length or
-    /// controlled displacement, in the direction of travel); the load
-    /// control's direction under load control.
-    pub load_slope: f64,
-    /// The lowest eigenvalue on the constraints, N/m.
-    pub eigenvalue: Option<f64>,
-    /// Its eigenvector, unknown order, weighted norm 1.
-    pub vector: Option<Vec<f64>>,
-}
-
-/// The indicators at `(state, lambda)` with tangent `t`, reached by the
-/// increment `previous` (none at the start).
-pub(super) fn indicators(
-    follower: &Follower,
-    state: &super::assembly::State,
-    lambda: f64,
-    t: &[f64],
-    previous: Option<(&[f64], f64)>,
-) -> Indicators {
-    let load_slope = match follower.control {
-        Control::Load => follower.sense,
-        Control::Arc { psi } => {
-            follower.orientation(t, previous) / (follower.corrector.dot(t, t) + psi * psi).sqrt()
-        }
-        Control::Displacement { dof, .. } => follower.sense / t[dof],
-    };
-    let (eigenvalue, vector) = if follower.stability {
-        match lowest_eigenpair(follower.corrector.solver, state, lambda) {
-            Ok(pair) => (Some(pair.eigenvalue), Some(pair.vector)),
-            Err(_) => (None, None),
-        }
-    } else {
-        (None, None)
-    };
-    Indicators {
-        load_slope,
-        eigenvalue,
-        vector,
-    }
-}
 
 /// The step from `from` to the fraction of size `h` where `f` changes
 /// sign, `f0` and `f1` its values at the step's start and end (of

@@ -21,10 +21,13 @@
 //! * `load_control` — Newton–Raphson with adaptive load stepping;
 //!   `arc_length` — arc-length continuation through limit points;
 //!   `stability` — the stability of one equilibrium;
-//! * `corrector` — Newton on equilibrium and one path constraint (load,
-//!   arc length, a displacement); `path` — path following to a target
-//!   ([`StaticSolver::follow_path`]), its steps recorded; `critical` —
-//!   limit and bifurcation points located on it, branch switching;
+//! * `path_spec` — what path following takes and returns; `corrector` —
+//!   Newton on equilibrium and one path constraint (load, arc length, a
+//!   displacement); `follower` — one step along the path and the critical
+//!   points' indicators where it lands; `critical` — limit and bifurcation
+//!   points located between two steps, landing on the target, branch
+//!   switching; `path` — path following to a target
+//!   ([`StaticSolver::follow_path`]), every step recorded;
 //! * `statics` — the solver's entry points ([`StaticSolver::solve`], …);
 //! * `limit` — the limit load ([`limit_load_factor`]).
 //!
@@ -39,12 +42,14 @@ mod circular_arc;
 mod condensed;
 mod corrector;
 mod critical;
+mod follower;
 mod joint;
 mod limit;
 mod load_control;
 mod model;
 mod node;
 mod path;
+mod path_spec;
 pub mod rotation;
 mod settings;
 mod solver;
@@ -62,7 +67,7 @@ pub use joint::JointKind;
 pub use limit::{limit_load_factor, LimitBound, LimitSearch};
 pub use model::{MechanicsError, Model, ModelBuilder, NodalLoad, Rod, RodSpec};
 pub use node::{Frame, NodeId};
-pub use path::{CriticalKind, CriticalPoint, PathPoint, PathSolution, PathSpec, PathTarget};
+pub use path_spec::{CriticalKind, CriticalPoint, PathPoint, PathSolution, PathSpec, PathTarget};
 pub use settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
 pub use solver::StaticSolver;
 pub use stability::{Mode, Stability};

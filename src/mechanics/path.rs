@@ -24,267 +24,17 @@
 
 use std::time::Instant;
 
-use serde::Serialize;
-
 use super::assembly::State;
-use super::corrector::{Constraint, Corrected, Corrector};
-use super::critical::{self, Indicators};
+use super::corrector::Corrector;
+use super::critical;
+use super::follower::{indicators, Control, Follower, Node, Run};
 use super::model::MechanicsError;
-use super::node::NodeId;
-use super::settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
+use super::path_spec::{PathSolution, PathSpec, PathTarget};
+use super::settings::{PathControl, StaticSettings, StaticSolution, StaticTermination};
 use super::solver::StaticSolver;
-use super::stability::Mode;
 
 /// Iterations a step aims for.
 const TARGET_ITERATIONS: f64 = 5.0;
-
-/// Where a path ends.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PathTarget {
-    /// The load factor reaches this value (the first time along the path).
-    LoadFactor(f64),
-    /// The translation `component` (0 = x, 1 = y, 2 = z) of `node`,
-    /// position minus reference position, reaches `value_m`.
-    Displacement {
-        /// The node.
-        node: NodeId,
-        /// Its translation component, 0 … 2.
-        component: usize,
-        /// The displacement to reach, m.
-        value_m: f64,
-    },
-    /// This many converged steps.
-    Steps(usize),
-}
-
-/// What to follow and record, beside the [`StaticSettings`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct PathSpec {
-    /// Where the path ends.
-    pub target: PathTarget,
-    /// The controlled translation `(node, component)` of
-    /// [`PathControl::Displacement`].
-    pub control: Option<(NodeId, usize)>,
-    /// Nodes whose displacement every recorded point carries.
-    pub record: Vec<NodeId>,
-}
-
-/// One equilibrium on the path.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PathPoint {
-    /// Load factor.
-    pub load_factor: f64,
-    /// Displacement of each recorded node ([`PathSpec::record`]), m.
-    pub displacements_m: Vec<[f64; 3]>,
-    /// The lowest eigenvalue of the stiffness on the joints' constraints
-    /// (signed, rotations × the mean element length), N/m; `None` without
-    /// the stability test.
-    pub lowest_stiffness_n_per_m: Option<f64>,
-    /// Newton iterations of the step that reached it.
-    pub iterations: usize,
-}
-
-/// The kind of a critical point.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CriticalKind {
-    /// A load maximum along the path.
-    LimitMaximum,
-    /// A load minimum along the path.
-    LimitMinimum,
-    /// The lowest eigenvalue crosses zero with no load extremum: another
-    /// branch of equilibria crosses the path here.
-    Bifurcation,
-}
-
-impl CriticalKind {
-    /// `limit` or `bifurcation`.
-    pub fn family(self) -> &'static str {
-        match self {
-            CriticalKind::LimitMaximum | CriticalKind::LimitMinimum => "limit",
-            CriticalKind::Bifurcation => "bifurcation",
-        }
-    }
-}
-
-/// A critical point of the path, located between two converged steps.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CriticalPoint {
-    /// Limit (maximum or minimum) or bifurcation.
-    pub kind: CriticalKind,
-    /// Its load factor.
-    pub load_factor: f64,
-    /// Displacement of each recorded node, m.
-    pub displacements_m: Vec<[f64; 3]>,
-    /// The lowest eigenvalue there, N/m (near zero).
-    pub lowest_stiffness_n_per_m: Option<f64>,
-    /// The index in the path of the last point before it.
-    pub after_point: usize,
-    /// True where the path left for the bifurcated branch.
-    pub switched_branch: bool,
-    /// The critical mode: the eigenvector of the lowest eigenvalue.
-    #[serde(skip)]
-    pub mode: Mode,
-}
-
-/// The equilibrium path followed.
-#[derive(Debug, Clone)]
-pub struct PathSolution {
-    /// The last equilibrium and how the path ended: `Converged` when the
-    /// target was reached; `MaxSteps` or `Stalled` before it.
-    pub solution: StaticSolution,
-    /// Every converged step, the start first.
-    pub points: Vec<PathPoint>,
-    /// Limit and bifurcation points, in path order.
-    pub critical_points: Vec<CriticalPoint>,
-}
-
-/// A converged point of the path and what the next step needs of it.
-#[derive(Clone)]
-pub(super) struct Node {
-    pub state: State,
-    pub lambda: f64,
-    /// The tangent `J⁻¹ f̂` there.
-    pub tangent: Vec<f64>,
-    /// The critical-point indicators there.
-    pub indicators: Indicators,
-}
-
-/// One way of moving along the path: the predictor and the constraint of
-/// a step of size `h` (load-factor units) from a node.
-#[derive(Debug, Clone, Copy)]
-pub(super) enum Control {
-    Load,
-    Arc {
-        /// `ψ`, m per unit λ: the first tangent's length.
-        psi: f64,
-    },
-    Displacement {
-        dof: usize,
-        /// The controlled unknown's first tangent component, m per unit λ.
-        scale: f64,
-    },
-}
-
-/// The path follower: the corrector, the control, the direction.
-pub(super) struct Follower<'a> {
-    pub corrector: Corrector<'a>,
-    pub control: Control,
-    /// `+1` or `−1`: the direction of the load factor (load control), of
-    /// the controlled displacement, or of the first arc-length step.
-    pub sense: f64,
-    /// Compute the lowest eigenvalue at each point.
-    pub stability: bool,
-    pub record: Vec<NodeId>,
-    /// `|dλ/dp|` at the start: the scale of the load slope's noise.
-    pub start_slope: f64,
-}
-
-impl Follower<'_> {
-    /// The step of size `h` from `from`, the previous increment
-    /// `previous` (none at the start) setting the direction; `None` when
-    /// the corrector fails.
-    pub fn step(&self, from: &Node, previous: Option<(&[f64], f64)>, h: f64) -> Option<Corrected> {
-        let t = &from.tangent;
-        let (d_lambda, constraint) = match self.control {
-            Control::Load => {
-                let d = self.sense * h;
-                (
-                    d,
-                    Constraint::Load {
-                        lambda: from.lambda + d,
-                    },
-                )
-            }
-            Control::Arc { psi } => {
-                let tn2 = self.corrector.dot(t, t);
-                let length = h * psi * std::f64::consts::SQRT_2;
-                let sigma = self.orientation(t, previous);
-                (
-                    sigma * length / (tn2 + psi * psi).sqrt(),
-                    Constraint::Arc { length, psi },
-                )
-            }
-            Control::Displacement { dof, scale } => {
-                let increment = self.sense * h * scale.abs();
-                (
-                    increment / t[dof],
-                    Constraint::Displacement { dof, increment },
-                )
-            }
-        };
-        if !d_lambda.is_finite() {
-            return None;
-        }
-        let du: Vec<f64> = t.iter().map(|t| d_lambda * t).collect();
-        self.corrector
-            .correct(&from.state, from.lambda, &du, d_lambda, constraint)
-    }
-
-    /// `+1` or `−1`: the direction along the tangent `(t, 1)` that keeps
-    /// the previous increment's (`ψ`-weighted dot product positive), or
-    /// [`Follower::sense`] without one.
-    pub fn orientation(&self, t: &[f64], previous: Option<(&[f64], f64)>) -> f64 {
-        let Some((du, dl)) = previous else {
-            return self.sense;
-        };
-        let psi = match self.control {
-            Control::Arc { psi } => psi,
-            _ => 0.0,
-        };
-        let along = self.corrector.dot(t, du) + psi * psi * dl;
-        if along < 0.0 {
-            -1.0
-        } else {
-            1.0
-        }
-    }
-
-    /// The node reached by a converged step: its tangent and indicators.
-    /// `None` when the tangent cannot be factored there.
-    pub fn node(&self, step: &Corrected) -> Option<Node> {
-        let tangent = self.corrector.tangent(&step.state, step.lambda)?;
-        let indicators = critical::indicators(
-            self,
-            &step.state,
-            step.lambda,
-            &tangent,
-            Some((&step.increment, step.d_lambda)),
-        );
-        Some(Node {
-            state: step.state.clone(),
-            lambda: step.lambda,
-            tangent,
-            indicators,
-        })
-    }
-
-    /// Displacements of the recorded nodes at `state`.
-    pub fn displacements(&self, state: &State) -> Vec<[f64; 3]> {
-        let reference = &self.corrector.solver.model().reference;
-        self.record
-            .iter()
-            .map(|&n| (state.frames[n].position_m - reference[n].position_m).into())
-            .collect()
-    }
-
-    /// The path point of a node.
-    pub fn point(&self, node: &Node, iterations: usize) -> PathPoint {
-        PathPoint {
-            load_factor: node.lambda,
-            displacements_m: self.displacements(&node.state),
-            lowest_stiffness_n_per_m: node.indicators.eigenvalue,
-            iterations,
-        }
-    }
-
-    /// The displacement of `(node, component)` at `state`.
-    pub fn displacement(&self, state: &State, node: NodeId, component: usize) -> f64 {
-        let reference = &self.corrector.solver.model().reference;
-        state.frames[node].position_m[component] - reference[node].position_m[component]
-    }
-}
-
 impl StaticSolver {
     /// Follow the equilibrium path from the unstressed frame to
     /// `spec.target` (module doc), recording every step and the critical
@@ -382,7 +132,7 @@ impl StaticSolver {
             start_slope: 0.0,
         };
         follower.sense = first_sense(&follower, spec, &tangent);
-        let indicators = critical::indicators(&follower, &start, 0.0, &tangent, None);
+        let indicators = indicators(&follower, &start, 0.0, &tangent, None);
         follower.start_slope = indicators.load_slope.abs();
         let mut node = Node {
             state: start,
@@ -513,19 +263,19 @@ impl StaticSolver {
             start_slope: 1.0,
         };
         let start = self.reference_state();
-        let indicators = critical::indicators(&follower, &start, 0.0, &tangent, None);
+        let first = indicators(&follower, &start, 0.0, &tangent, None);
         let at = |state: &State, lambda: f64| Node {
             state: state.clone(),
             lambda,
             tangent: Vec::new(),
-            indicators: critical::indicators(&follower, state, lambda, &[], None),
+            indicators: indicators(&follower, state, lambda, &[], None),
         };
         let mut points = vec![follower.point(
             &Node {
                 state: start.clone(),
                 lambda: 0.0,
                 tangent,
-                indicators,
+                indicators: first,
             },
             0,
         )];
@@ -574,27 +324,4 @@ fn first_sense(follower: &Follower, spec: &PathSpec, tangent: &[f64]) -> f64 {
         }
     };
     controlled.map_or(load, |(_, scale)| load * sign(scale))
-}
-
-/// What a path run has gathered.
-pub(super) struct Run {
-    pub points: Vec<PathPoint>,
-    pub critical_points: Vec<CriticalPoint>,
-    pub steps: Vec<StepRecord>,
-    pub newton_iterations: usize,
-    pub rejected_steps: usize,
-    pub reactions: Vec<[f64; 6]>,
-}
-
-impl Run {
-    /// Record a converged step reaching `node`.
-    pub fn accept(&mut self, follower: &Follower, step: &Corrected, node: &Node) {
-        self.points.push(follower.point(node, step.iterations));
-        self.steps.push(StepRecord {
-            load_factor: step.lambda,
-            iterations: step.iterations,
-            residuals: step.residuals.clone(),
-        });
-        self.reactions.clone_from(&step.reactions);
-    }
 }

@@ -149,3 +149,52 @@ pub fn euler_column(
     b.add_load(rod.end(), Vector3::new(-load_n, 0.0, 0.0), Vector3::zeros());
     (StaticSolver::new(b.build().unwrap()).unwrap(), rod.nodes)
 }
+
+/// Radius (m) and in-plane bending stiffness (N·m²) of the ring; out of
+/// plane and in torsion 10 × stiffer (its out-of-plane critical load is
+/// then far above the in-plane one), EA and GA 1e6 × EI/R².
+pub const RING_RADIUS_M: f64 = 1.0;
+pub const RING_EI_NM2: f64 = 1.0;
+
+/// A quarter of a circular ring (one arc rod of `elements` elements from
+/// θ = 0 to θ = π/2 in the x–y plane) with the supports of its symmetry
+/// about both axes — each end held tangentially, out of plane and in
+/// rotation, free radially — under uniform radial dead loads `q` (N/m,
+/// inward) lumped at the nodes (half at each end). The symmetric modes of
+/// the whole ring (cos 2θ, cos 4θ, …) are its modes, and no rigid rotation
+/// enters them. Returns the solver and the rod's nodes.
+pub fn quarter_ring(elements: usize, q: f64) -> (StaticSolver, Vec<NodeId>) {
+    use ringmesh::mechanics::CircularArc;
+    let (r, ei) = (RING_RADIUS_M, RING_EI_NM2);
+    let spec = RodSpec {
+        section: Section {
+            axial_n: 1e6 * ei / (r * r),
+            shear_n: [1e6 * ei / (r * r); 2],
+            torsion_nm2: 10.0 * ei,
+            bending_nm2: [ei, 10.0 * ei],
+        },
+        elements,
+        kind: ElementKind::Se3,
+    };
+    let mut b = ModelBuilder::new();
+    let rod = b.add_arc_rod(
+        Vector3::new(r, 0.0, 0.0),
+        Vector3::new(0.0, r, 0.0),
+        &CircularArc::Centre {
+            centre_m: Vector3::zeros(),
+            normal: Some(Vector3::z()),
+        },
+        Vector3::z(),
+        &spec,
+    );
+    b.fix(rod.start(), [false, true, true, true, true, true]);
+    b.fix(rod.end(), [true, false, true, true, true, true]);
+    let step = std::f64::consts::FRAC_PI_2 / elements as f64;
+    for (i, &n) in rod.nodes.iter().enumerate() {
+        let theta = i as f64 * step;
+        let share = if i == 0 || i == elements { 0.5 } else { 1.0 };
+        let force = -q * r * step * share * Vector3::new(theta.cos(), theta.sin(), 0.0);
+        b.add_load(n, force, Vector3::zeros());
+    }
+    (StaticSolver::new(b.build().unwrap()).unwrap(), rod.nodes)
+}
