@@ -384,3 +384,108 @@ fn a_ring_under_radial_dead_loads_buckles_at_four_ei_over_r_cubed() {
     }
     assert!(errors[2].abs() <= 5e-3, "errors {errors:?}");
 }
+
+/// The paper's cantilever (L = 10 m, EI = 100 N·m², 10 SE(3) elements)
+/// with section stiffnesses `(EA, GA)` under the dead tip load `P` across
+/// it (PL²/EI = `load`): the tip, and how the solve ended.
+fn cantilever_tip(
+    (axial, shear): (f64, f64),
+    load: f64,
+) -> (nalgebra::Vector3<f64>, StaticTermination) {
+    let (l, ei) = (10.0, 100.0);
+    let spec = ringmesh::mechanics::RodSpec {
+        section: ringmesh::mechanics::Section {
+            axial_n: axial,
+            shear_n: [shear, shear],
+            torsion_nm2: ei,
+            bending_nm2: [ei, ei],
+        },
+        elements: 10,
+        kind: ringmesh::mechanics::ElementKind::Se3,
+    };
+    let mut b = ringmesh::mechanics::ModelBuilder::new();
+    let rod = b.add_rod(
+        nalgebra::Vector3::zeros(),
+        nalgebra::Vector3::new(l, 0.0, 0.0),
+        nalgebra::Vector3::z(),
+        &spec,
+    );
+    b.fix(rod.start(), [true; 6]);
+    let force = load * ei / (l * l);
+    b.add_load(
+        rod.end(),
+        nalgebra::Vector3::new(0.0, force, 0.0),
+        nalgebra::Vector3::zeros(),
+    );
+    let solver = ringmesh::mechanics::StaticSolver::new(b.build().unwrap()).unwrap();
+    let solution = solver.solve(&StaticSettings::default()).unwrap();
+    (
+        solution.state.frames[rod.end()].position_m,
+        solution.termination,
+    )
+}
+
+#[test]
+fn a_near_rigid_section_converges_to_the_flexible_answer() {
+    // EA = 1e8·EI/L² and GA = 1e4·EA: its force roundoff (~1e-3 N) is far
+    // above the force tolerance (1e-10 of the 0.5 N load), so the force
+    // test alone never passes — Newton stalled at λ = 0 before the
+    // increment test. The tip must agree with a flexible section's
+    // (EA = GA = 1e6·EI/L²) to its shear and stretch, ~PL/GA = 5e-6 m, and
+    // with the inextensible elastica's x_tip = √(2 sin α)·√(EI/P), α the
+    // tip rotation, L√(P/EI) = √2 ∫₀^√(sin α) dv/√(1 − (sin α − v²)²), to
+    // the discretisation error.
+    let (l, load) = (10.0, 0.5);
+    let stiff = 1e8 * 100.0 / (l * l);
+    let (tip, ending) = cantilever_tip((stiff, 1e4 * stiff), load);
+    assert_eq!(ending, StaticTermination::Converged);
+    let soft = 1e6 * 100.0 / (l * l);
+    let (flexible, _) = cantilever_tip((soft, soft), load);
+    let give = 2.0 * (load * 100.0 / (l * l)) * l / soft;
+    assert!(
+        (tip - flexible).norm() <= give,
+        "stiff {tip:?} vs flexible {flexible:?}"
+    );
+    // The elastica: α from the load by bisection on the integral
+    // (Simpson, 2 000 panels, its integrand smooth for α < π/2).
+    let integral = |alpha: f64| {
+        let top = alpha.sin().sqrt();
+        let f = |v: f64| 1.0 / (1.0 - (alpha.sin() - v * v).powi(2)).sqrt();
+        let n = 2000;
+        let h = top / n as f64;
+        let sum: f64 = (0..=n)
+            .map(|i| {
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * f(i as f64 * h)
+            })
+            .sum();
+        std::f64::consts::SQRT_2 * sum * h / 3.0
+    };
+    let (mut lo, mut hi) = (0.0, 1.5);
+    while hi - lo > 1e-13 {
+        let mid = 0.5 * (lo + hi);
+        if integral(mid) < load.sqrt() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let alpha = 0.5 * (lo + hi);
+    let x_tip = (2.0 * alpha.sin()).sqrt() * l / load.sqrt();
+    let error = (tip.x - x_tip).abs() / l;
+    assert!(
+        error <= 2e-4,
+        "tip x {} vs the elastica's {x_tip} ({error:e})",
+        tip.x
+    );
+    eprintln!(
+        "near-rigid cantilever: tip {tip:.9?}, flexible {flexible:.9?} ({:.1e}), elastica x {x_tip:.9} ({error:.1e})",
+        (tip - flexible).norm()
+    );
+}
