@@ -18,10 +18,19 @@ pub fn norm2(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Largest magnitude `‖a‖∞` of a slice (0 for an empty one).
+/// Largest magnitude `‖a‖∞` of a slice (0 for an empty one), NaN if any
+/// entry is NaN: `f64::max` drops a NaN, so a residual with one read as
+/// converged (a curved element whose rotation's derivative was NaN at
+/// exactly a quarter turn 'converged' without moving).
 #[inline]
 pub fn norm_inf(a: &[f64]) -> f64 {
-    a.iter().fold(0.0, |m, v| m.max(v.abs()))
+    a.iter().fold(0.0, |m: f64, v| {
+        if m.is_nan() || v.is_nan() {
+            f64::NAN
+        } else {
+            m.max(v.abs())
+        }
+    })
 }
 
 /// Euclidean norm of a 3-vector.
@@ -113,6 +122,8 @@ mod tests {
         assert_eq!(norm3([2.0, 3.0, 6.0]), 7.0);
         assert_eq!(norm_inf(&[1.0, -8.0, 2.0]), 8.0);
         assert_eq!(norm_inf(&[]), 0.0);
+        assert!(norm_inf(&[1.0, f64::NAN, 2.0]).is_nan());
+        assert!(norm_inf(&[f64::NAN, 3.0]).is_nan());
         assert_eq!(dot(&[1.0, 2.0], &[3.0, -1.0]), 1.0);
         assert_eq!(sub3([1.0, 2.0, 3.0], [1.0, 1.0, 1.0]), [0.0, 1.0, 2.0]);
     }

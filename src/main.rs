@@ -883,6 +883,9 @@ fn frame_summary(o: &FrameOutput) -> String {
         StaticTermination::MaxSteps { load_factor } => {
             format!("ran out of steps (MAX STEPS) at load factor {load_factor:.6}")
         }
+        StaticTermination::Overflow { load_factor } => {
+            format!("OVERFLOWED beyond load factor {load_factor:.6}")
+        }
     };
     let reaction = o
         .reactions

@@ -373,4 +373,16 @@ fn a_frame_run_that_ends_early_writes_its_state_and_exits_3() {
         serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert!(json["load_factor"].as_f64().unwrap() < 1.0);
     assert_ne!(json["termination"], "converged");
+    // The path it followed is written too: the start and every step.
+    let points = json["path"]["points"].as_array().unwrap();
+    assert_eq!(
+        points.len() as u64,
+        json["load_steps"].as_u64().unwrap() + 1
+    );
+    let csv = std::fs::read_to_string(out.with_file_name("frame-path.csv")).unwrap();
+    assert_eq!(
+        csv.lines().filter(|l| l.starts_with("step,")).count(),
+        points.len()
+    );
+    assert!(out.with_file_name("frame-path.png").exists());
 }

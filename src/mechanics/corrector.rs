@@ -70,6 +70,9 @@ pub(super) struct Corrector<'a> {
     pub w: Vec<f64>,
     /// The reference load `f̂`, unknown order (zero on joint rows).
     pub f_hat: Vec<f64>,
+    /// The last failed correction met a residual, tangent or increment
+    /// that is not finite.
+    pub non_finite: std::cell::Cell<bool>,
 }
 
 impl<'a> Corrector<'a> {
@@ -80,6 +83,7 @@ impl<'a> Corrector<'a> {
             settings,
             w: solver.weights(),
             f_hat: reference_load(solver),
+            non_finite: std::cell::Cell::new(false),
         }
     }
 
@@ -104,7 +108,9 @@ impl<'a> Corrector<'a> {
 
     /// Newton from `start` (an equilibrium at `lambda0`) moved by the
     /// predictor `(du, d_lambda)` onto the path, subject to `constraint`.
-    /// `None` when it does not converge within the iteration budget.
+    /// `None` when it does not converge within the iteration budget;
+    /// [`Corrector::non_finite`] then says whether it met a number that is
+    /// not finite.
     pub fn correct(
         &self,
         start: &State,
@@ -113,6 +119,7 @@ impl<'a> Corrector<'a> {
         d_lambda: f64,
         constraint: Constraint,
     ) -> Option<Corrected> {
+        self.non_finite.set(false);
         let system = self.solver.system();
         let n = system.n_rows;
         let mut state = start.clone();
@@ -131,6 +138,7 @@ impl<'a> Corrector<'a> {
             let (force, converged) = self.solver.converged(&ev, lambda, self.settings);
             residuals.push(force);
             if !force.is_finite() {
+                self.non_finite.set(true);
                 return None;
             }
             if converged || small {
@@ -147,7 +155,14 @@ impl<'a> Corrector<'a> {
             if it == self.settings.max_iterations {
                 return None;
             }
-            let lu = system.factor(&ev.values).ok()?;
+            let lu = match system.factor(&ev.values) {
+                Ok(lu) => lu,
+                Err(e) => {
+                    self.non_finite
+                        .set(matches!(e, super::assembly::FactorError::NotFinite { .. }));
+                    return None;
+                }
+            };
             let mut rhs = Mat::from_fn(n, 2, |i, j| {
                 if j == 0 {
                     -ev.residual[i]
@@ -174,6 +189,7 @@ impl<'a> Corrector<'a> {
                 .map(|(r, f)| r + d_lambda * f)
                 .collect();
             if !(d_lambda.is_finite() && delta.iter().all(|d| d.is_finite())) {
+                self.non_finite.set(true);
                 return None;
             }
             small = self

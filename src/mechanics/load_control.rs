@@ -11,7 +11,7 @@
 
 use std::time::Instant;
 
-use super::assembly::{State, System};
+use super::assembly::{FactorError, State, System};
 use super::settings::{StaticSettings, StaticSolution, StaticTermination, StepRecord};
 use super::solver::{wdot, StaticSolver};
 use crate::algebra::norm2;
@@ -90,6 +90,8 @@ struct NewtonRun {
     /// Some increment `δ` had negative curvature `δuᵀ H δu`: Newton passed
     /// through a state where the structure is unstable.
     negative_curvature: bool,
+    /// Newton failed on a residual, tangent or increment that is not finite.
+    non_finite: bool,
 }
 
 /// Why a load step was undone.
@@ -126,6 +128,7 @@ fn newton(
         reactions: vec![],
         secant: 0.0,
         negative_curvature: false,
+        non_finite: false,
     };
     let mut increment = vec![0.0; solver.system().n_rows];
     let (mut predictor, mut previous) = (0.0, 0.0);
@@ -142,6 +145,7 @@ fn newton(
         run.residuals.push(force);
         run.iterations = it;
         if !force.is_finite() {
+            run.non_finite = true;
             break;
         }
         if converged || increment_small {
@@ -157,13 +161,18 @@ fn newton(
         if it == settings.max_iterations {
             break;
         }
-        let Ok(lu) = solver.system().factor(&ev.values) else {
-            break;
+        let lu = match solver.system().factor(&ev.values) {
+            Ok(lu) => lu,
+            Err(e) => {
+                run.non_finite = matches!(e, FactorError::NotFinite { .. });
+                break;
+            }
         };
         let mut rhs = solver.system().column(&ev.residual);
         System::solve_in_place(&lu, rhs.as_mut());
         let delta: Vec<f64> = (0..solver.system().n_rows).map(|i| -rhs[(i, 0)]).collect();
         if !delta.iter().all(|d| d.is_finite()) {
+            run.non_finite = true;
             break;
         }
         let curvature: f64 = delta
@@ -361,6 +370,11 @@ pub(super) fn follow_observed(
             Err(why) => {
                 rejected_steps += 1;
                 step *= 0.25;
+                if step < settings.min_step && run.non_finite {
+                    break StaticTermination::Overflow {
+                        load_factor: lambda,
+                    };
+                }
                 if step < settings.min_step {
                     break match why {
                         Rejection::OffBranch => StaticTermination::LimitPoint {

@@ -165,6 +165,11 @@ impl StaticSolver {
                 run.newton_iterations += settings.max_iterations;
                 run.rejected_steps += 1;
                 h *= 0.25;
+                if h < settings.min_step && follower.corrector.non_finite.get() {
+                    break StaticTermination::Overflow {
+                        load_factor: node.lambda,
+                    };
+                }
                 if h < settings.min_step {
                     break StaticTermination::Stalled {
                         load_factor: node.lambda,

@@ -39,6 +39,14 @@ pub enum StaticTermination {
         /// Last converged load factor.
         load_factor: f64,
     },
+    /// Beyond `load_factor` every step, down to the smallest, gave a
+    /// residual or an increment that is not a finite number: loads or
+    /// stiffnesses beyond double precision (a 1e200 N·m moment), not a
+    /// failure to converge.
+    Overflow {
+        /// Last converged load factor.
+        load_factor: f64,
+    },
 }
 
 impl std::fmt::Display for StaticTermination {
@@ -60,6 +68,12 @@ impl std::fmt::Display for StaticTermination {
             StaticTermination::MaxSteps { load_factor } => {
                 write!(f, "ran out of load steps at load factor {load_factor:.4}")
             }
+            StaticTermination::Overflow { load_factor } => write!(
+                f,
+                "overflowed: beyond load factor {load_factor:.4} the residual or the \
+                 displacements are not finite numbers (loads or stiffnesses beyond double \
+                 precision)"
+            ),
         }
     }
 }

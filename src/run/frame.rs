@@ -177,6 +177,12 @@ pub fn frame(
         .follow_path(&file.path, &file.settings)
         .map_err(FrameFileError::from)?;
     let solution = followed.solution;
+    if let StaticTermination::Overflow { .. } = solution.termination {
+        return Err(FrameFileError::from(MechanicsError::NotFinite {
+            detail: format!("the path {}", solution.termination),
+        })
+        .into());
+    }
     let reference = file.model.reference();
     let nodes: Vec<FrameNodeOutput> = solution
         .state
