@@ -11,28 +11,13 @@ use std::time::Instant;
 use faer::Mat;
 
 use super::assembly::{State, System};
+use super::corrector::reference_load;
 use super::load_control;
 use super::settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
 use super::solver::{wdot, StaticSolver};
 
 /// Iterations a step aims for; the arc length adapts as `√(target / used)`.
 const TARGET_ITERATIONS: f64 = 5.0;
-
-/// The reference load `f̂` in unknown order (zero on joint rows).
-fn reference_load(solver: &StaticSolver, system: &System) -> Vec<f64> {
-    let mut f = vec![0.0; system.n_rows];
-    for l in solver.model().loads() {
-        for c in 0..3 {
-            if let Some(i) = system.unknown(l.node, c) {
-                f[i] += l.force_n[c];
-            }
-            if let Some(i) = system.unknown(l.node, 3 + c) {
-                f[i] += l.moment_nm[c];
-            }
-        }
-    }
-    f
-}
 
 /// Follows the path from `start`, an equilibrium at load factor `lambda0`,
 /// to λ = 1, or to a limit point.
@@ -57,7 +42,7 @@ pub(super) fn follow_observed(
 ) -> StaticSolution {
     let clock = Instant::now();
     let system = solver.system();
-    let f_hat = reference_load(solver, system);
+    let f_hat = reference_load(solver);
     let w = solver.weights();
     let n = system.n_rows;
 
