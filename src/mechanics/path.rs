@@ -35,6 +35,7 @@ use super::solver::StaticSolver;
 
 /// Iterations a step aims for.
 const TARGET_ITERATIONS: f64 = 5.0;
+
 impl StaticSolver {
     /// Follow the equilibrium path from the unstressed frame to
     /// `spec.target` (module doc), recording every step and the critical
@@ -66,12 +67,22 @@ impl StaticSolver {
             node, component, ..
         } = spec.target
         {
-            if node >= nodes || component > 2 {
+            if node >= nodes || component > 2 || self.system().unknown(node, component).is_none()
+            {
                 return bad(
                     "path.target",
-                    format!("node {node} component {component} is not a translation of the frame"),
+                    format!(
+                        "node {node} component {component} is not a free translation of the \
+                         frame: it cannot reach a displacement"
+                    ),
                 );
             }
+        }
+        if settings.branch_switch && settings.path != PathControl::ArcLength {
+            return bad(
+                "solver.branch_switch",
+                "leaving a bifurcation for its branch needs path = \"arc_length\"".into(),
+            );
         }
         if let PathTarget::Steps(0) = spec.target {
             return bad("path.target", "must be at least one step".into());
