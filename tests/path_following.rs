@@ -127,6 +127,14 @@ fn displacement_control_follows_the_von_mises_truss_to_a_displacement() {
     let misfit = misfit_on_von_mises_path(&path, applied, p_lim);
     assert!(misfit <= 1e-6, "off the closed form by {misfit:e} P_lim");
     assert_both_limits(&path, applied);
+    eprintln!(
+        "displacement control: {} points, misfit {misfit:e} P_lim, limits {:?}",
+        path.points.len(),
+        path.critical_points
+            .iter()
+            .map(|c| c.load_factor)
+            .collect::<Vec<_>>()
+    );
     // Monotone in the controlled displacement.
     assert!(path
         .points

@@ -67,8 +67,7 @@ impl StaticSolver {
             node, component, ..
         } = spec.target
         {
-            if node >= nodes || component > 2 || self.system().unknown(node, component).is_none()
-            {
+            if node >= nodes || component > 2 || self.system().unknown(node, component).is_none() {
                 return bad(
                     "path.target",
                     format!(
