@@ -497,3 +497,86 @@ fn a_near_rigid_section_converges_to_the_flexible_answer() {
         (tip - flexible).norm()
     );
 }
+
+#[test]
+fn arc_length_follows_a_snap_back_through_limit_points_in_displacement() {
+    // The von Mises truss loaded through a soft vertical spring (a bar of
+    // axial stiffness k = 50 N/m above the apex, 1 m long): on the truss's
+    // descending branch |dP/dy| reaches 99 N/m > k, so the load point's
+    // displacement d = Δy_apex − P/k turns back twice — limit points in
+    // displacement (snap-back), which displacement control of the load
+    // point cannot pass and arc length must. Every step: the truss on
+    // P(y) = λP and the spring shortened by λP/k.
+    use nalgebra::Vector3;
+    use ringmesh::mechanics::{
+        ElementKind, JointKind, ModelBuilder, RodSpec, Section, StaticSolver,
+    };
+    let (p_lim, _) = von_mises_limit();
+    let applied = 1.5 * p_lim;
+    let k = 50.0;
+    let bar = |axial: f64| RodSpec {
+        section: Section {
+            axial_n: axial,
+            shear_n: [1e4, 1e4],
+            torsion_nm2: 100.0,
+            bending_nm2: [100.0, 100.0],
+        },
+        elements: 1,
+        kind: ElementKind::Se3,
+    };
+    let apex = Vector3::new(0.0, VM_RISE_M, 0.0);
+    let top = Vector3::new(0.0, VM_RISE_M + 1.0, 0.0);
+    let mut b = ModelBuilder::new();
+    let left = b.add_rod(Vector3::new(-1.0, 0.0, 0.0), apex, Vector3::z(), &bar(1e4));
+    let right = b.add_rod(Vector3::new(1.0, 0.0, 0.0), apex, Vector3::z(), &bar(1e4));
+    let spring = b.add_rod(apex, top, Vector3::z(), &bar(k * 1.0));
+    let pin = [true, true, true, true, true, false];
+    b.fix(left.start(), pin);
+    b.fix(right.start(), pin);
+    // The spring's top slides along y only, without turning.
+    b.fix(spring.end(), [true, false, true, true, true, true]);
+    b.add_joint(JointKind::Spherical, left.end(), right.end(), apex);
+    b.add_joint(JointKind::Spherical, left.end(), spring.start(), apex);
+    b.add_load(
+        spring.end(),
+        Vector3::new(0.0, -applied, 0.0),
+        Vector3::zeros(),
+    );
+    let solver = StaticSolver::new(b.build().unwrap()).unwrap();
+    let spec = PathSpec {
+        target: PathTarget::LoadFactor(1.0),
+        control: None,
+        record: vec![left.end(), spring.end()],
+    };
+    let settings = StaticSettings {
+        path: PathControl::ArcLength,
+        ..StaticSettings::default()
+    };
+    let path = solver.follow_path(&spec, &settings).unwrap();
+    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    let mut misfit: f64 = 0.0;
+    for p in &path.points {
+        let (apex_dy, top_dy) = (p.displacements_m[0][1], p.displacements_m[1][1]);
+        let load = p.load_factor * applied;
+        misfit = misfit
+            .max((von_mises_load(VM_RISE_M + apex_dy) - load).abs() / p_lim)
+            .max(((apex_dy - top_dy) * k - load).abs() / p_lim);
+    }
+    assert!(misfit <= 1e-6, "off the closed form by {misfit:e} P_lim");
+    // The load point's displacement reverses at least twice along the path.
+    let d: Vec<f64> = path
+        .points
+        .iter()
+        .map(|p| p.displacements_m[1][1])
+        .collect();
+    let reversals = d
+        .windows(3)
+        .filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < 0.0)
+        .count();
+    assert!(reversals >= 2, "no snap-back: {d:?}");
+    assert_both_limits(&path, applied);
+    eprintln!(
+        "snap-back: {} points, misfit {misfit:e} P_lim, {reversals} reversals of the load point's displacement",
+        path.points.len()
+    );
+}
