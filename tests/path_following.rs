@@ -580,3 +580,52 @@ fn arc_length_follows_a_snap_back_through_limit_points_in_displacement() {
         path.points.len()
     );
 }
+
+#[test]
+fn a_steps_target_ends_after_that_many_steps() {
+    let (p_lim, _) = von_mises_limit();
+    let (solver, apex) = von_mises(1.5 * p_lim);
+    let spec = PathSpec {
+        target: PathTarget::Steps(7),
+        control: None,
+        record: vec![apex],
+    };
+    let settings = StaticSettings {
+        path: PathControl::ArcLength,
+        ..StaticSettings::default()
+    };
+    let path = solver.follow_path(&spec, &settings).unwrap();
+    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    assert_eq!(path.points.len(), 8);
+    assert_eq!(path.solution.steps.len(), 7);
+}
+
+#[test]
+fn a_frame_run_out_of_steps_exits_3_with_its_path_written() {
+    // The shipped snap-through with a budget of 5 steps: exit 3, the
+    // reason, and the path so far (the start and 5 steps) in every file.
+    let root = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::problem("frames/von-mises-snap.toml")).unwrap();
+    let file = root.path().join("frame.toml");
+    std::fs::write(
+        &file,
+        text.replace("max_step = 0.05", "max_step = 0.05\nmax_steps = 5"),
+    )
+    .unwrap();
+    let out = root.path().join("frame.json");
+    let run = common::ringmesh(&["frame", file.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("ran out of load steps"), "{stderr}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(json["termination"]["status"], "max_steps");
+    assert_eq!(json["path"]["points"].as_array().unwrap().len(), 6);
+    let csv = std::fs::read_to_string(root.path().join("frame-path.csv")).unwrap();
+    assert_eq!(
+        csv.lines().filter(|l| l.starts_with("step,")).count(),
+        6,
+        "{csv}"
+    );
+    assert!(root.path().join("frame-path.svg").exists());
+}
