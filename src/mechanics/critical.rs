@@ -22,9 +22,9 @@
 //! crosses the path transversally there, in the direction of the mode).
 
 use super::corrector::{Constraint, Corrected};
-use super::follower::{Control, Follower, Node, Run};
+use super::follower::{load_slope, Control, Follower, Node, Run};
 use super::path_spec::{CriticalKind, CriticalPoint, PathTarget};
-use super::stability::translations;
+use super::stability::{lowest_eigenpair, translations};
 
 /// Largest number of re-solved fractions in one location.
 const MAX_LOCATE: usize = 80;
@@ -50,19 +50,21 @@ const SWITCH_ATTEMPTS: usize = 4;
 
 /// The step from `from` to the fraction of size `h` where `f` changes
 /// sign, `f0` and `f1` its values at the step's start and end (of
-/// opposite signs): regula falsi, Illinois variant. Returns the step and
-/// node where `|f|` was least, with that value.
+/// opposite signs): regula falsi, Illinois variant. `f` computes only what
+/// it needs of a re-solved step (`None`: no value there, the fraction is
+/// halved as where the corrector fails). Returns the step where `|f|` was
+/// least, with that value.
 fn locate(
     follower: &Follower,
     from: &Node,
     previous: Option<(&[f64], f64)>,
     h: f64,
     (f0, f1): (f64, f64),
-    f: impl Fn(&Corrected, &Node) -> f64,
-) -> Option<(Corrected, Node, f64)> {
+    f: impl Fn(&Corrected) -> Option<f64>,
+) -> Option<(Corrected, f64)> {
     let (mut a, mut fa, mut b, mut fb) = (0.0, f0, 1.0, f1);
     let mut side = 0;
-    let mut best: Option<(Corrected, Node, f64)> = None;
+    let mut best: Option<(Corrected, f64)> = None;
     let scale = from.lambda.abs().max(1.0);
     for _ in 0..MAX_LOCATE {
         let mut tau = (a * fb - b * fa) / (fb - fa);
@@ -71,8 +73,8 @@ fn locate(
         }
         let found = follower
             .step(from, previous, tau * h)
-            .and_then(|s| follower.node(&s).map(|n| (s, n)));
-        let Some((step, node)) = found else {
+            .and_then(|s| f(&s).map(|v| (s, v)));
+        let Some((step, value)) = found else {
             // No equilibrium there (the corrector failed): halve instead.
             if (b - tau) > (tau - a) {
                 b = 0.5 * (a + b);
@@ -81,12 +83,11 @@ fn locate(
             }
             continue;
         };
-        let value = f(&step, &node);
         if !value.is_finite() {
             break;
         }
-        if best.as_ref().is_none_or(|(_, _, v)| value.abs() < v.abs()) {
-            best = Some((step, node, value));
+        if best.as_ref().is_none_or(|(_, v)| value.abs() < v.abs()) {
+            best = Some((step, value));
         }
         if value == 0.0 {
             break;
@@ -149,7 +150,7 @@ pub(super) fn land(
         } => follower.displacement(&s.state, node, component) - value_m,
         PathTarget::Steps(_) => 0.0,
     };
-    let (near, _, _) = locate(follower, from, previous, h, (q0, q1), |s, _| quantity(s))?;
+    let (near, _) = locate(follower, from, previous, h, (q0, q1), |s| Some(quantity(s)))?;
     let constraint = match target {
         PathTarget::LoadFactor(l) => Constraint::Load { lambda: l },
         PathTarget::Displacement {
@@ -198,9 +199,12 @@ pub(super) fn between(
     let after_point = run.points.len().saturating_sub(2);
     let noise = SLOPE_NOISE * follower.start_slope;
     if g0 * g1 < 0.0 && g0.abs().max(g1.abs()) > noise {
-        let (_, node, _) = locate(follower, from, previous, h, (g0, g1), |_, n| {
-            n.indicators.load_slope
-        })?;
+        let slope = |s: &Corrected| {
+            let t = follower.corrector.tangent(&s.state, s.lambda)?;
+            Some(load_slope(follower, &t, Some((&s.increment, s.d_lambda))))
+        };
+        let (step, _) = locate(follower, from, previous, h, (g0, g1), slope)?;
+        let node = follower.node(&step)?;
         let kind = if g0 > 0.0 {
             CriticalKind::LimitMaximum
         } else {
@@ -216,9 +220,13 @@ pub(super) fn between(
     if m0 * m1 >= 0.0 {
         return None;
     }
-    let (_, node, value) = locate(follower, from, previous, h, (m0, m1), |_, n| {
-        n.indicators.eigenvalue.unwrap_or(f64::NAN)
-    })?;
+    let eigenvalue = |s: &Corrected| {
+        lowest_eigenpair(follower.corrector.solver, &s.state, s.lambda)
+            .ok()
+            .map(|pair| pair.eigenvalue)
+    };
+    let (step, value) = locate(follower, from, previous, h, (m0, m1), eigenvalue)?;
+    let node = follower.node(&step)?;
     if value.abs() > CROSSING * m0.abs().max(m1.abs()) {
         return None;
     }

@@ -150,6 +150,22 @@ impl Follower<'_> {
         }
     }
 
+    /// The path point of an equilibrium `(state, lambda)` reached in
+    /// `iterations`, its lowest eigenvalue computed if asked for.
+    pub fn point_at(&self, state: &State, lambda: f64, iterations: usize) -> PathPoint {
+        let lowest = self.stability.then(|| {
+            lowest_eigenpair(self.corrector.solver, state, lambda)
+                .ok()
+                .map(|pair| pair.eigenvalue)
+        });
+        PathPoint {
+            load_factor: lambda,
+            displacements_m: self.displacements(state),
+            lowest_stiffness_n_per_m: lowest.flatten(),
+            iterations,
+        }
+    }
+
     /// The displacement of `(node, component)` at `state`.
     pub fn displacement(&self, state: &State, node: NodeId, component: usize) -> f64 {
         let reference = &self.corrector.solver.model().reference;
@@ -202,13 +218,6 @@ pub(super) fn indicators(
     t: &[f64],
     previous: Option<(&[f64], f64)>,
 ) -> Indicators {
-    let load_slope = match follower.control {
-        Control::Load => follower.sense,
-        Control::Arc { psi } => {
-            follower.orientation(t, previous) / (follower.corrector.dot(t, t) + psi * psi).sqrt()
-        }
-        Control::Displacement { dof, .. } => follower.sense / t[dof],
-    };
     let (eigenvalue, vector) = if follower.stability {
         match lowest_eigenpair(follower.corrector.solver, state, lambda) {
             Ok(pair) => (Some(pair.eigenvalue), Some(pair.vector)),
@@ -218,8 +227,20 @@ pub(super) fn indicators(
         (None, None)
     };
     Indicators {
-        load_slope,
+        load_slope: load_slope(follower, t, previous),
         eigenvalue,
         vector,
+    }
+}
+
+/// The load's derivative along the path at a point of tangent `t`,
+/// reached by the increment `previous` ([`Indicators::load_slope`]).
+pub(super) fn load_slope(follower: &Follower, t: &[f64], previous: Option<(&[f64], f64)>) -> f64 {
+    match follower.control {
+        Control::Load => follower.sense,
+        Control::Arc { psi } => {
+            follower.orientation(t, previous) / (follower.corrector.dot(t, t) + psi * psi).sqrt()
+        }
+        Control::Displacement { dof, .. } => follower.sense / t[dof],
     }
 }

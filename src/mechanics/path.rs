@@ -24,7 +24,6 @@
 
 use std::time::Instant;
 
-use super::assembly::State;
 use super::corrector::Corrector;
 use super::critical;
 use super::follower::{indicators, Control, Follower, Node, Run};
@@ -90,6 +89,9 @@ impl StaticSolver {
             return bad("loads", "there are no loads to follow".into());
         }
         let corrector = Corrector::new(self, settings);
+        if settings.path == PathControl::Load {
+            return self.follow_load(spec, settings, corrector, clock);
+        }
         let start = self.reference_state();
         let tangent = corrector
             .tangent(&start, 0.0)
@@ -97,40 +99,37 @@ impl StaticSolver {
                 detail: "the unstressed frame's tangent cannot be factored".into(),
             })?;
         let psi = corrector.dot(&tangent, &tangent).sqrt();
-        let control = match settings.path {
-            PathControl::Load => {
-                return self.follow_load(spec, settings, tangent, corrector, clock);
-            }
-            PathControl::ArcLength => Control::Arc { psi },
-            PathControl::Displacement => {
-                let Some((node, component)) = spec.control else {
-                    return bad(
-                        "path.control",
-                        "displacement control needs the controlled node and component".into(),
-                    );
-                };
-                let dof = (node < nodes && component < 3)
-                    .then(|| self.system().unknown(node, component))
-                    .flatten();
-                let Some(dof) = dof else {
-                    return bad(
-                        "path.control",
-                        format!("node {node} component {component} is not a free translation"),
-                    );
-                };
-                if tangent[dof] == 0.0 {
-                    return bad(
-                        "path.control",
-                        format!(
-                            "node {node} component {component} does not move under the loads \
+        let control = if settings.path == PathControl::ArcLength {
+            Control::Arc { psi }
+        } else {
+            // Displacement control.
+            let Some((node, component)) = spec.control else {
+                return bad(
+                    "path.control",
+                    "displacement control needs the controlled node and component".into(),
+                );
+            };
+            let dof = (node < nodes && component < 3)
+                .then(|| self.system().unknown(node, component))
+                .flatten();
+            let Some(dof) = dof else {
+                return bad(
+                    "path.control",
+                    format!("node {node} component {component} is not a free translation"),
+                );
+            };
+            if tangent[dof] == 0.0 {
+                return bad(
+                    "path.control",
+                    format!(
+                        "node {node} component {component} does not move under the loads \
                              at the start: it cannot drive the path"
-                        ),
-                    );
-                }
-                Control::Displacement {
-                    dof,
-                    scale: tangent[dof],
-                }
+                    ),
+                );
+            }
+            Control::Displacement {
+                dof,
+                scale: tangent[dof],
             }
         };
         let mut follower = Follower {
@@ -258,7 +257,6 @@ impl StaticSolver {
         &self,
         spec: &PathSpec,
         settings: &StaticSettings,
-        tangent: Vec<f64>,
         corrector: Corrector,
         clock: Instant,
     ) -> Result<PathSolution, MechanicsError> {
@@ -278,29 +276,14 @@ impl StaticSolver {
             start_slope: 1.0,
         };
         let start = self.reference_state();
-        let first = indicators(&follower, &start, 0.0, &tangent, None);
-        let at = |state: &State, lambda: f64| Node {
-            state: state.clone(),
-            lambda,
-            tangent: Vec::new(),
-            indicators: indicators(&follower, state, lambda, &[], None),
-        };
-        let mut points = vec![follower.point(
-            &Node {
-                state: start.clone(),
-                lambda: 0.0,
-                tangent,
-                indicators: first,
-            },
-            0,
-        )];
+        let mut points = vec![follower.point_at(&start, 0.0, 0)];
         let mut solution = super::load_control::follow_observed(
             self,
             start,
             0.0,
             settings,
             &mut |state, lambda, iterations| {
-                points.push(follower.point(&at(state, lambda), iterations))
+                points.push(follower.point_at(state, lambda, iterations))
             },
         );
         solution.time_s = clock.elapsed().as_secs_f64();
