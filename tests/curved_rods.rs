@@ -10,10 +10,10 @@
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use ringmesh::frame::{FrameFile, FrameFileError};
+use ringmesh::frame::{cantilever, FrameFile};
 use ringmesh::mechanics::rotation::{log, rod_frame};
 use ringmesh::mechanics::{
-    CircularArc, ElementKind, Frame, JointKind, ModelBuilder, RodSpec, Section, StaticSettings,
+    CircularArc, ElementKind, Frame, JointKind, ModelBuilder, RodSpec, StaticSettings,
     StaticSolution, StaticSolver, StaticTermination,
 };
 
@@ -21,19 +21,9 @@ mod common;
 
 use common::angle_between;
 
-/// The section of the paper's cantilever: `EA = GA = 1e4 N`, `GJ = EI = 100 N·m²`.
-fn section() -> Section {
-    Section {
-        axial_n: 1e4,
-        shear_n: [1e4, 1e4],
-        torsion_nm2: 100.0,
-        bending_nm2: [100.0, 100.0],
-    }
-}
-
 fn spec(elements: usize, kind: ElementKind) -> RodSpec {
     RodSpec {
-        section: section(),
+        section: cantilever::section(),
         elements,
         kind,
     }
@@ -135,7 +125,7 @@ fn a_reference_arc_is_stress_free_on_its_circle_with_tangent_first_axes() {
 const RADIUS_M: f64 = 2.0;
 
 fn quarter_tip(moment_nm: f64) -> (Vector3<f64>, UnitQuaternion<f64>) {
-    let kappa = 1.0 / RADIUS_M + moment_nm / section().bending_nm2[0];
+    let kappa = 1.0 / RADIUS_M + moment_nm / cantilever::section().bending_nm2[0];
     let psi = kappa * FRAC_PI_2 * RADIUS_M;
     let tip = Vector3::new(
         RADIUS_M - 1.0 / kappa + psi.cos() / kappa,
@@ -203,7 +193,7 @@ fn a_quarter_circle_under_an_end_moment_stays_a_circle_of_curvature_one_over_r_p
     // 16 (to the solver's tolerance); chords through the same nodes are a
     // polygon, short of the arc by 1 − sin(Δφ/2)/(Δφ/2) and kinked, and miss
     // the tip by orders of magnitude more, even at 16 elements.
-    let ei = section().bending_nm2[0];
+    let ei = cantilever::section().bending_nm2[0];
     for ratio in [0.5, -0.5] {
         let moment = ratio * ei / RADIUS_M;
         for elements in [1, 4, 16] {
@@ -234,7 +224,7 @@ fn crisfield_jelenic_arcs_bend_by_m_over_ei_times_the_arc_length() {
     // element's arc length, so the rotation a uniform moment adds, M s/EI
     // over the whole arc, is exact at any mesh (with chord lengths it would
     // be short by M (s − Σ chords)/EI: 8e-2 rad at 1 element).
-    let moment = 0.5 * section().bending_nm2[0] / RADIUS_M;
+    let moment = 0.5 * cantilever::section().bending_nm2[0] / RADIUS_M;
     let mut previous = f64::INFINITY;
     for elements in [1, 4, 16] {
         let (position, rotation) =
@@ -447,16 +437,7 @@ fn malformed_arcs_name_the_key_at_fault() {
         ),
     ];
     for (what, text, expected) in cases {
-        let error: FrameFileError = match FrameFile::from_toml(&text) {
-            Ok(_) => panic!("{what}: accepted"),
-            Err(e) => e,
-        };
-        assert!(error.is_bad_input(), "{what}");
-        let message = error.to_string();
-        assert!(
-            message.contains(expected),
-            "{what}: {message:?} does not contain {expected:?}"
-        );
+        common::frames::assert_refused(what, &text, expected);
     }
     // The engine names the rod and the arc's input on its own.
     let mut b = ModelBuilder::new();

@@ -6,7 +6,7 @@
 mod common;
 
 use nalgebra::Vector3;
-use ringmesh::frame::{cantilever, FrameFile, FrameFileError};
+use ringmesh::frame::{cantilever, FrameFile};
 use ringmesh::mechanics::{StaticSolver, StaticTermination};
 use serde_json::Value;
 
@@ -246,16 +246,7 @@ fn malformed_frame_files_name_the_key_at_fault() {
         ),
     ];
     for (what, text, expected) in cases {
-        let error: FrameFileError = match FrameFile::from_toml(&text) {
-            Ok(_) => panic!("{what}: accepted"),
-            Err(e) => e,
-        };
-        assert!(error.is_bad_input(), "{what}");
-        let message = error.to_string();
-        assert!(
-            message.contains(expected),
-            "{what}: {message:?} does not contain {expected:?}"
-        );
+        common::frames::assert_refused(what, &text, expected);
     }
 }
 

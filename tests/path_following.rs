@@ -6,13 +6,29 @@
 mod common;
 
 use common::frames::{
-    euler_column, quarter_ring, von_mises, von_mises_limit, von_mises_load, ColumnEnds,
-    COLUMN_EI_NM2, COLUMN_LENGTH_M, RING_EI_NM2, RING_RADIUS_M, VM_RISE_M,
+    euler_column, quarter_ring, von_mises, von_mises_limit, von_mises_load, von_mises_loaded,
+    ColumnEnds, COLUMN_EI_NM2, COLUMN_LENGTH_M, RING_EI_NM2, RING_RADIUS_M, VM_RISE_M,
 };
 use ringmesh::mechanics::{
-    CriticalKind, PathControl, PathSolution, PathSpec, PathTarget, StaticSettings,
+    CriticalKind, PathControl, PathSolution, PathSpec, PathTarget, StaticSettings, StaticSolver,
     StaticTermination,
 };
+
+/// Path following by arc length, the other settings their defaults.
+fn arc_length() -> StaticSettings {
+    StaticSettings {
+        path: PathControl::ArcLength,
+        ..StaticSettings::default()
+    }
+}
+
+/// Follows `solver`'s path as `spec` and `settings` say, and checks it
+/// reached its target.
+fn reach(solver: &StaticSolver, spec: PathSpec, settings: StaticSettings) -> PathSolution {
+    let path = solver.follow_path(&spec, &settings).unwrap();
+    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    path
+}
 
 /// Every recorded point of the von Mises path lies on `P(y) = λ P_applied`
 /// to `1e-6 P_lim`; returns the largest misfit over `P_lim`.
@@ -64,17 +80,15 @@ fn arc_length_follows_the_von_mises_truss_through_snap_through() {
     let (p_lim, _) = von_mises_limit();
     let applied = 1.5 * p_lim;
     let (solver, apex) = von_mises(applied);
-    let spec = PathSpec {
-        target: PathTarget::LoadFactor(1.0),
-        control: None,
-        record: vec![apex],
-    };
-    let settings = StaticSettings {
-        path: PathControl::ArcLength,
-        ..StaticSettings::default()
-    };
-    let path = solver.follow_path(&spec, &settings).unwrap();
-    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    let path = reach(
+        &solver,
+        PathSpec {
+            target: PathTarget::LoadFactor(1.0),
+            control: None,
+            record: vec![apex],
+        },
+        arc_length(),
+    );
     assert!((path.solution.load_factor - 1.0).abs() <= 1e-12);
     let misfit = misfit_on_von_mises_path(&path, applied, p_lim);
     assert!(misfit <= 1e-6, "off the closed form by {misfit:e} P_lim");
@@ -120,8 +134,7 @@ fn displacement_control_follows_the_von_mises_truss_to_a_displacement() {
         path: PathControl::Displacement,
         ..StaticSettings::default()
     };
-    let path = solver.follow_path(&spec, &settings).unwrap();
-    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    let path = reach(&solver, spec, settings);
     let end = path.points.last().unwrap().displacements_m[0][1];
     assert!((end - target).abs() <= 1e-9, "ended at {end} for {target}");
     let misfit = misfit_on_von_mises_path(&path, applied, p_lim);
@@ -177,17 +190,15 @@ fn discrete_critical_by_bisection(ends: ColumnEnds, elements: usize) -> f64 {
 fn column_bifurcation(ends: ColumnEnds, elements: usize) -> (f64, f64) {
     let applied = 1.25 * ends.critical_load_n();
     let (solver, nodes) = euler_column(ends, elements, applied, COLUMN_STIFF);
-    let spec = PathSpec {
-        target: PathTarget::LoadFactor(1.0),
-        control: None,
-        record: vec![*nodes.last().unwrap()],
-    };
-    let settings = StaticSettings {
-        path: PathControl::ArcLength,
-        ..StaticSettings::default()
-    };
-    let path = solver.follow_path(&spec, &settings).unwrap();
-    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    let path = reach(
+        &solver,
+        PathSpec {
+            target: PathTarget::LoadFactor(1.0),
+            control: None,
+            record: vec![*nodes.last().unwrap()],
+        },
+        arc_length(),
+    );
     let bifurcations: Vec<_> = path
         .critical_points
         .iter()
@@ -275,18 +286,18 @@ fn branch_switching_follows_the_elastica_of_a_buckled_column() {
     let applied = 1.3 * ends.critical_load_n();
     let (solver, nodes) = euler_column(ends, elements, applied, COLUMN_STIFF);
     let tip = *nodes.last().unwrap();
-    let spec = PathSpec {
-        target: PathTarget::LoadFactor(1.0),
-        control: None,
-        record: vec![tip],
-    };
-    let settings = StaticSettings {
-        path: PathControl::ArcLength,
-        branch_switch: true,
-        ..StaticSettings::default()
-    };
-    let path = solver.follow_path(&spec, &settings).unwrap();
-    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    let path = reach(
+        &solver,
+        PathSpec {
+            target: PathTarget::LoadFactor(1.0),
+            control: None,
+            record: vec![tip],
+        },
+        StaticSettings {
+            branch_switch: true,
+            ..arc_length()
+        },
+    );
     let switched: Vec<_> = path
         .critical_points
         .iter()
@@ -342,17 +353,15 @@ fn a_ring_under_radial_dead_loads_buckles_at_four_ei_over_r_cubed() {
     let mut errors = Vec::new();
     for elements in [4, 8, 16] {
         let (solver, nodes) = quarter_ring(elements, applied);
-        let spec = PathSpec {
-            target: PathTarget::LoadFactor(1.0),
-            control: None,
-            record: vec![nodes[0]],
-        };
-        let settings = StaticSettings {
-            path: PathControl::ArcLength,
-            ..StaticSettings::default()
-        };
-        let path = solver.follow_path(&spec, &settings).unwrap();
-        assert_eq!(path.solution.termination, StaticTermination::Converged);
+        let path = reach(
+            &solver,
+            PathSpec {
+                target: PathTarget::LoadFactor(1.0),
+                control: None,
+                record: vec![nodes[0]],
+            },
+            arc_length(),
+        );
         let [b] = path.critical_points.as_slice() else {
             panic!("{elements} elements: {:?}", path.critical_points);
         };
@@ -507,53 +516,19 @@ fn arc_length_follows_a_snap_back_through_limit_points_in_displacement() {
     // displacement (snap-back), which displacement control of the load
     // point cannot pass and arc length must. Every step: the truss on
     // P(y) = λP and the spring shortened by λP/k.
-    use nalgebra::Vector3;
-    use ringmesh::mechanics::{
-        ElementKind, JointKind, ModelBuilder, RodSpec, Section, StaticSolver,
-    };
     let (p_lim, _) = von_mises_limit();
     let applied = 1.5 * p_lim;
     let k = 50.0;
-    let bar = |axial: f64| RodSpec {
-        section: Section {
-            axial_n: axial,
-            shear_n: [1e4, 1e4],
-            torsion_nm2: 100.0,
-            bending_nm2: [100.0, 100.0],
+    let (solver, apex, top) = von_mises_loaded(applied, Some(k));
+    let path = reach(
+        &solver,
+        PathSpec {
+            target: PathTarget::LoadFactor(1.0),
+            control: None,
+            record: vec![apex, top],
         },
-        elements: 1,
-        kind: ElementKind::Se3,
-    };
-    let apex = Vector3::new(0.0, VM_RISE_M, 0.0);
-    let top = Vector3::new(0.0, VM_RISE_M + 1.0, 0.0);
-    let mut b = ModelBuilder::new();
-    let left = b.add_rod(Vector3::new(-1.0, 0.0, 0.0), apex, Vector3::z(), &bar(1e4));
-    let right = b.add_rod(Vector3::new(1.0, 0.0, 0.0), apex, Vector3::z(), &bar(1e4));
-    let spring = b.add_rod(apex, top, Vector3::z(), &bar(k * 1.0));
-    let pin = [true, true, true, true, true, false];
-    b.fix(left.start(), pin);
-    b.fix(right.start(), pin);
-    // The spring's top slides along y only, without turning.
-    b.fix(spring.end(), [true, false, true, true, true, true]);
-    b.add_joint(JointKind::Spherical, left.end(), right.end(), apex);
-    b.add_joint(JointKind::Spherical, left.end(), spring.start(), apex);
-    b.add_load(
-        spring.end(),
-        Vector3::new(0.0, -applied, 0.0),
-        Vector3::zeros(),
+        arc_length(),
     );
-    let solver = StaticSolver::new(b.build().unwrap()).unwrap();
-    let spec = PathSpec {
-        target: PathTarget::LoadFactor(1.0),
-        control: None,
-        record: vec![left.end(), spring.end()],
-    };
-    let settings = StaticSettings {
-        path: PathControl::ArcLength,
-        ..StaticSettings::default()
-    };
-    let path = solver.follow_path(&spec, &settings).unwrap();
-    assert_eq!(path.solution.termination, StaticTermination::Converged);
     let mut misfit: f64 = 0.0;
     for p in &path.points {
         let (apex_dy, top_dy) = (p.displacements_m[0][1], p.displacements_m[1][1]);
@@ -585,17 +560,15 @@ fn arc_length_follows_a_snap_back_through_limit_points_in_displacement() {
 fn a_steps_target_ends_after_that_many_steps() {
     let (p_lim, _) = von_mises_limit();
     let (solver, apex) = von_mises(1.5 * p_lim);
-    let spec = PathSpec {
-        target: PathTarget::Steps(7),
-        control: None,
-        record: vec![apex],
-    };
-    let settings = StaticSettings {
-        path: PathControl::ArcLength,
-        ..StaticSettings::default()
-    };
-    let path = solver.follow_path(&spec, &settings).unwrap();
-    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    let path = reach(
+        &solver,
+        PathSpec {
+            target: PathTarget::Steps(7),
+            control: None,
+            record: vec![apex],
+        },
+        arc_length(),
+    );
     assert_eq!(path.points.len(), 8);
     assert_eq!(path.solution.steps.len(), 7);
 }

@@ -2,6 +2,7 @@
 //! the von Mises truss.
 
 use nalgebra::Vector3;
+use ringmesh::frame::{cantilever, FrameFile};
 use ringmesh::mechanics::{
     ElementKind, JointKind, ModelBuilder, NodeId, RodSpec, Section, StaticSolver,
 };
@@ -18,14 +19,23 @@ pub const VM_EA_N: f64 = 1e4;
 /// clamped), joined at the apex by a spherical joint, the apex loaded
 /// downward by `load_n`.
 pub fn von_mises(load_n: f64) -> (StaticSolver, NodeId) {
-    let section = Section {
-        axial_n: VM_EA_N,
-        shear_n: [1e4, 1e4],
-        torsion_nm2: 100.0,
-        bending_nm2: [100.0, 100.0],
-    };
-    let spec = RodSpec {
-        section,
+    let (solver, apex, _) = von_mises_loaded(load_n, None);
+    (solver, apex)
+}
+
+/// [`von_mises`] loaded through a vertical spring of stiffness
+/// `spring_n_per_m` (a bar 1 m long above the apex, joined to it by a
+/// spherical joint, its top sliding along y without turning), or at the
+/// apex without one: the solver, the apex and the loaded node.
+pub fn von_mises_loaded(
+    load_n: f64,
+    spring_n_per_m: Option<f64>,
+) -> (StaticSolver, NodeId, NodeId) {
+    let bar = |axial_n: f64| RodSpec {
+        section: Section {
+            axial_n,
+            ..cantilever::section()
+        },
         elements: 1,
         kind: ElementKind::Se3,
     };
@@ -35,24 +45,33 @@ pub fn von_mises(load_n: f64) -> (StaticSolver, NodeId) {
         Vector3::new(-VM_HALF_SPAN_M, 0.0, 0.0),
         apex,
         Vector3::z(),
-        &spec,
+        &bar(VM_EA_N),
     );
     let right = b.add_rod(
         Vector3::new(VM_HALF_SPAN_M, 0.0, 0.0),
         apex,
         Vector3::z(),
-        &spec,
+        &bar(VM_EA_N),
     );
     let pin = [true, true, true, true, true, false];
     b.fix(left.start(), pin);
     b.fix(right.start(), pin);
     b.add_joint(JointKind::Spherical, left.end(), right.end(), apex);
-    b.add_load(
+    let loaded = match spring_n_per_m {
+        None => left.end(),
+        Some(k) => {
+            let spring = b.add_rod(apex, apex + Vector3::y(), Vector3::z(), &bar(k));
+            b.fix(spring.end(), [true, false, true, true, true, true]);
+            b.add_joint(JointKind::Spherical, left.end(), spring.start(), apex);
+            spring.end()
+        }
+    };
+    b.add_load(loaded, Vector3::new(0.0, -load_n, 0.0), Vector3::zeros());
+    (
+        StaticSolver::new(b.build().unwrap()).unwrap(),
         left.end(),
-        Vector3::new(0.0, -load_n, 0.0),
-        Vector3::zeros(),
-    );
-    (StaticSolver::new(b.build().unwrap()).unwrap(), left.end())
+        loaded,
+    )
 }
 
 /// The apex load that holds the apex at height `y`. Straight bars of length
@@ -197,4 +216,19 @@ pub fn quarter_ring(elements: usize, q: f64) -> (StaticSolver, Vec<NodeId>) {
         b.add_load(n, force, Vector3::zeros());
     }
     (StaticSolver::new(b.build().unwrap()).unwrap(), rod.nodes)
+}
+
+/// The frame file `text` is refused as bad input with a message containing
+/// `expected` (`what` names the case).
+pub fn assert_refused(what: &str, text: &str, expected: &str) {
+    let error = match FrameFile::from_toml(text) {
+        Ok(_) => panic!("{what}: accepted"),
+        Err(e) => e,
+    };
+    assert!(error.is_bad_input(), "{what}");
+    let message = error.to_string();
+    assert!(
+        message.contains(expected),
+        "{what}: {message:?} does not contain {expected:?}"
+    );
 }
