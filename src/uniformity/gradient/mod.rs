@@ -12,13 +12,17 @@
 //! force density, or of `[q]` if lower, keeps `D` numerically positive
 //! definite); for `q ≪ [q]`, `θ ≈ ln(q/[q])`. The objective is
 //!
-//! $$J = \frac{1}{n_s L^2}\Big(\sum_{i\in\text{surf}} e_i^2 + λ_{\text{lay}}
-//!   \sum_i d_i^2\Big) + w \sum_g R_g(T) + κ \ln^2\frac{\bar T_0}{t_0} + ν B(q)$$
+//! $$J = \frac{1}{n_s}\Big(\sum_{i\in\text{surf}} \frac{e_i^2}{ε^2} + λ_{\text{lay}}
+//!   \sum_i \frac{d_i^2}{ε^2}\Big) + w \sum_g R_g(T)
+//!   + κ \Big(\frac{\ln(\bar T_0/t_0)}{10^{-3}}\Big)^2 + ν B(q),$$
+//!
+//! every term a pure number in the units of its own tolerance, so that the
+//! weights mean the same on every scene and at every mesh density:
 //!
 //! * **surface**: `e_i = z_i − (x_i² + y_i²)/(4F)` at every surface node for a
-//!   paraboloid target, `|x_i − x̂_i|` for a prescribed one; `L` is the mean
-//!   design length of the first set's cables and `n_s` the number of surface
-//!   nodes, so the term is a dimensionless mean square;
+//!   paraboloid target, `|x_i − x̂_i|` for a prescribed one; `ε` is the surface
+//!   tolerance ([`Gradient::surface_tolerance_m`]) and `n_s` the number of
+//!   surface nodes: the term is `(RMS/ε)²`;
 //! * **layout** (`λ_lay` = [`Gradient::layout_weight`]): `d_i` is the plan drift
 //!   of a surface node from its design position (paraboloid target) and the 3-D
 //!   drift of every other free node (rear net). Without it the problem is not
@@ -26,17 +30,20 @@
 //!   an equal-tension layout on the paraboloid (on `small-hex`, `Tmax/Tmin` = 1.000
 //!   with 0.19 m of plan drift), or the rear nodes move so that tilted ties
 //!   balance any front-net tension;
-//! * **ratio surrogate**: `R_g = smax_β(s) − smin_β(s)` over the set's
-//!   `s_k = ln T_k`, with the normalised log-sum-exp
-//!   `smax_β(s) = (1/β) ln((1/n) Σ e^{β s_k})` and `smin_β(s) = −smax_β(−s)`:
-//!   smooth, below `ln(Tmax/Tmin)` by at most `2 ln(n)/β`, equal to it as the
-//!   sharpness `β → ∞`;
+//! * **ratio surrogate** (eq. 5's objective): `R_g = smax_β(s) − smin_β(s)` over
+//!   the set's tensions in units of its target, `s_k = ln(T_k/t_g)`, with the
+//!   normalised log-sum-exp `smax_β(s) = (1/β) ln((1/n) Σ e^{β s_k})` and
+//!   `smin_β(s) = −smax_β(−s)`: smooth, below `ln(Tmax/Tmin)` by at most
+//!   `2 ln(n)/β`, equal to it as the sharpness `β → ∞`. So `w` is the price of
+//!   the surface in ratio: at `w = 1` an RMS of `ε` costs as much as a factor
+//!   `e` in `Tmax/Tmin`;
 //! * **level**: a homogeneous network's shape is invariant under `q → c q`, so
-//!   without a level term the minimum is a ray, not a point;
-//! * **bound barrier** `B = Σ_k (ln(q̲_k/q_k))₊³ + (ln(q_k/q̄))₊³`, C², zero inside
-//!   the box `T_k ≥ f t_0` (at design lengths; `f` the problem's
+//!   without a level term the minimum is a ray, not a point; its unit is a
+//!   mean tension 0.1 % off the target `t_0`;
+//! * **bound barrier** `B = Σ_k (ln(q̲_k/q_k)/10⁻²)₊³ + (ln(q_k/q̄)/10⁻²)₊³`, C²,
+//!   zero inside the box `T_k ≥ f t_0` (at design lengths; `f` the problem's
 //!   `min_tension_fraction`) and `q_k ≤ 0.99 [q]`, where the map does not
-//!   saturate.
+//!   saturate; its unit is 1 % beyond a bound.
 //!
 //! `T_k = q_k ℓ_k(x(q))`: the tension terms enter `∂J/∂q` through `q_k` and
 //! `∂J/∂x` through `ℓ_k`; one adjoint solve with the factor of the forward solve
@@ -74,13 +81,15 @@
 //! grows ×3 per run up to [`Gradient::sharpness`] (a smooth surrogate first, the
 //! sharp one at the end). At the final sharpness the solve has converged when
 //! the stationarity `‖dJ/dθ‖∞ / J` (checked at every accepted iterate) falls
-//! to [`Gradient::gradient_tolerance`], or when a whole run lowers `J` by no
-//! more than [`Gradient::cost_tolerance`]`·|J|`. Terminations: `Converged`
-//! (either test), `MaxIterations`, `Stalled` (a line search that failed in
-//! the last run, or a design below the tension floor that positive force
-//! densities could avoid), `Infeasible` (a shape that needs slack cables: the
-//! slack analysis names the nodes), `NumericalError` (a forward solve failed:
-//! the best point so far is returned).
+//! to [`Gradient::gradient_tolerance`], and only then. It ends without that
+//! when a whole run lowers `J` by no more than
+//! [`Gradient::cost_tolerance`]`·|J|` (at the rounding of `J`: `Stalled`,
+//! with the stationarity it reached in a warning). Terminations: `Converged`,
+//! `MaxIterations`, `Stalled` (no progress over a run, a line search that
+//! failed in the last run, or a design below the tension floor that positive
+//! force densities could avoid), `Infeasible` (a shape that needs slack
+//! cables: the slack analysis names the nodes), `NumericalError` (a forward
+//! solve failed: the best point so far is returned).
 //!
 //! The start, in order: a neighbouring problem's design
 //! ([`super::UniformitySolver::solve_from`]: the previous outer iteration's,
@@ -113,9 +122,13 @@ const SHARPNESS_GROWTH: f64 = 3.0;
 /// Adjoint-gradient L-BFGS on the free geometry (see the module documentation).
 #[derive(Debug, Clone)]
 pub struct Gradient {
-    /// Weight `w` of the ratio surrogate against the surface error: larger buys a
-    /// lower `Tmax/Tmin` with a larger surface error (the design-front knob).
+    /// Weight `w` of the ratio surrogate `ln(Tmax/Tmin)` against the surface
+    /// term `(RMS/ε)²`: larger buys a lower `Tmax/Tmin` with a larger surface
+    /// error (the design-front knob).
     pub weight: f64,
+    /// Surface tolerance `ε`, m: the unit of the surface error and of the
+    /// layout drift.
+    pub surface_tolerance_m: f64,
     /// Weight of the layout drift against the surface error (0: free layout).
     pub layout_weight: f64,
     /// Sharpness `β` of the soft max/min of `ln T`: larger follows `Tmax/Tmin`
@@ -124,9 +137,9 @@ pub struct Gradient {
     /// Sharpness of the first L-BFGS run; it grows ×3 per restart up to
     /// `sharpness` (continuation: smooth first, sharp at the end).
     pub initial_sharpness: f64,
-    /// Weight `κ` of the pretension-level term `ln²(T̄₀/t₀)`.
+    /// Weight `κ` of the pretension-level term `(ln(T̄₀/t₀)/10⁻³)²`.
     pub level_weight: f64,
-    /// Weight `ν` of the bound barrier.
+    /// Weight `ν` of the bound barrier (its unit: 1 % beyond a bound).
     pub barrier_weight: f64,
     /// Number of correction pairs L-BFGS keeps.
     pub memory: usize,
@@ -139,8 +152,9 @@ pub struct Gradient {
     /// Converged (at the final sharpness) when the stationarity
     /// `‖dJ/dθ‖∞ / J` falls to this: scale-free, and independent of the start.
     pub gradient_tolerance: f64,
-    /// Converged (at the final sharpness) when a whole L-BFGS run lowers `J` by
-    /// no more than `cost_tolerance · |J|`.
+    /// Stop (at the final sharpness) when a whole L-BFGS run lowers `J` by no
+    /// more than `cost_tolerance · |J|`: `Converged` if the stationarity
+    /// holds, `Stalled` if it does not.
     pub cost_tolerance: f64,
     /// Precondition L-BFGS (see the module documentation); `false` runs it on `θ`.
     pub precondition: bool,
@@ -155,7 +169,8 @@ pub struct Gradient {
 impl Default for Gradient {
     fn default() -> Self {
         Gradient {
-            weight: 1e-6,
+            weight: 1.0,
+            surface_tolerance_m: 1e-3,
             layout_weight: 1.0,
             sharpness: 1000.0,
             initial_sharpness: 10.0,
@@ -197,6 +212,7 @@ impl Gradient {
             }
         }
         for (what, v) in [
+            ("surface_tolerance_m", self.surface_tolerance_m),
             ("sharpness", self.sharpness),
             ("initial_sharpness", self.initial_sharpness),
             ("level_weight", self.level_weight),
@@ -366,8 +382,20 @@ impl Gradient {
             }
             // Objective change over a whole run (restart_iterations iterations, or
             // up to a line search that could not go on).
-            if before - after <= self.cost_tolerance * after.abs() {
-                termination = Termination::Converged;
+            if termination != Termination::Converged
+                && before - after <= self.cost_tolerance * after.abs()
+            {
+                termination = if history.stationarity <= self.gradient_tolerance {
+                    Termination::Converged
+                } else {
+                    warnings.push(format!(
+                        "J stopped decreasing (by at most {:.0e} of J over a run) at \
+                         stationarity {:.2e}, above the tolerance {:.0e}",
+                        self.cost_tolerance, history.stationarity, self.gradient_tolerance
+                    ));
+                    Termination::Stalled
+                };
+                break;
             }
         }
         let design = Design::evaluate(
@@ -444,14 +472,15 @@ impl UniformitySolver for Gradient {
         "gradient"
     }
 
-    /// The ratio weight from 1e-8 to 1: the surface term is normalised, so
-    /// 1e-6 is already near the exact-equilibrium design.
+    /// The ratio weight from 10⁻² to 10⁶: the surface term is in units of the
+    /// tolerance (1 mm by default), so 10⁻² holds the surface to a few µm and
+    /// 10⁶ lets it go by centimetres, whatever the scene.
     fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
         Some(KnobRange {
             name: "weight",
             exact: None,
-            low: 1e-8,
-            high: 1.0,
+            low: 1e-2,
+            high: 1e6,
         })
     }
 

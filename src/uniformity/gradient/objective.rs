@@ -8,6 +8,14 @@ use crate::uniformity::{SurfaceTarget, UniformityError, UniformityProblem};
 /// Upper edge of the barrier's free box, as a fraction of `[q]`.
 const UPPER_FRACTION: f64 = 0.99;
 
+/// Unit of the level term: a mean tension `LEVEL_UNIT` (relative) off its
+/// target costs `κ`.
+const LEVEL_UNIT: f64 = 1e-3;
+
+/// Unit of the bound barrier: a force density `BARRIER_UNIT` (relative) beyond
+/// its bound costs `ν`.
+const BARRIER_UNIT: f64 = 1e-2;
+
 /// Normalised log-sum-exp `(1/β) ln((1/n) Σ e^{β s_k})`, and its weights
 /// `softmax(β s)` written into `weights`.
 pub(super) fn soft_max(s: &[f64], beta: f64, weights: &mut [f64]) -> f64 {
@@ -31,9 +39,11 @@ pub(super) struct Objective<'a> {
     weight: f64,
     layout_weight: f64,
     sharpness: f64,
+    /// `κ / LEVEL_UNIT²`.
     level_weight: f64,
+    /// `ν / BARRIER_UNIT³`.
     barrier_weight: f64,
-    /// `1/(n_s L²)`.
+    /// `1/(n_s ε²)`.
     surface_scale: f64,
     /// Free nodes that are not surface nodes.
     other_free: Vec<usize>,
@@ -46,9 +56,7 @@ pub(super) struct Objective<'a> {
 impl<'a> Objective<'a> {
     pub(super) fn new(settings: &Gradient, problem: &'a UniformityProblem) -> Self {
         let lengths = problem.lengths_m();
-        let first = &problem.sets()[0];
-        let length_scale =
-            first.edges.iter().map(|&k| lengths[k]).sum::<f64>() / first.edges.len() as f64;
+        let tolerance = settings.surface_tolerance_m;
         let n_surface = problem.surface_nodes().len().max(1) as f64;
         let mut is_surface = vec![false; problem.network().n_nodes()];
         for &i in problem.surface_nodes() {
@@ -61,9 +69,9 @@ impl<'a> Objective<'a> {
             weight: settings.weight,
             layout_weight: settings.layout_weight,
             sharpness: settings.sharpness,
-            level_weight: settings.level_weight,
-            barrier_weight: settings.barrier_weight,
-            surface_scale: 1.0 / (n_surface * length_scale * length_scale),
+            level_weight: settings.level_weight / (LEVEL_UNIT * LEVEL_UNIT),
+            barrier_weight: settings.barrier_weight / BARRIER_UNIT.powi(3),
+            surface_scale: 1.0 / (n_surface * tolerance * tolerance),
             other_free: problem
                 .structure()
                 .free_nodes()
@@ -166,8 +174,13 @@ impl<'a> Objective<'a> {
         let mut up = Vec::new();
         let mut down = Vec::new();
         for set in problem.sets() {
+            // ln T in units of the set's target: the same numbers at any level.
             s.clear();
-            s.extend(set.edges.iter().map(|&k| tensions[k].ln()));
+            s.extend(
+                set.edges
+                    .iter()
+                    .map(|&k| (tensions[k] / set.mean_tension_n).ln()),
+            );
             up.resize(s.len(), 0.0);
             down.resize(s.len(), 0.0);
             let high = soft_max(&s, self.sharpness, &mut up);
