@@ -95,6 +95,64 @@ fn assert_gradient_matches_central_differences(solver: &Gradient, problem: &Unif
     }
 }
 
+/// The objective's terms are in the units of their tolerances: at a design
+/// on its target level and above the tension floor, `J` with no ratio term
+/// is `(RMS/ε)²` for the surface tolerance ε, and the ratio term adds `w`
+/// times `ln(Tmax/Tmin)` less the soft maximum's bias (at most `2 ln(n)/β`).
+#[test]
+fn objective_terms_are_in_units_of_their_tolerances() {
+    let problem = common::front_problem(&common::scene("small-hex"));
+    let set = &problem.sets()[0];
+    // lp's optimum moved off the paraboloid, then scaled back onto the
+    // target level (a homogeneous net's shape is invariant under q → c q).
+    let lp = Lp.solve(&problem).unwrap();
+    let mut q: Vec<f64> =
+        lp.q.iter()
+            .enumerate()
+            .map(|(k, q)| q * (1.0 + 0.05 * (((k * 7919) % 201) as f64 - 100.0) / 100.0))
+            .collect();
+    let eq = problem.forward(&q).unwrap();
+    let mean =
+        set.edges.iter().map(|&k| eq.edges_forces_n[k]).sum::<f64>() / set.edges.len() as f64;
+    for v in q.iter_mut() {
+        *v *= set.mean_tension_n / mean;
+    }
+    let eq = problem.forward(&q).unwrap();
+    let rms = problem.surface_rms_m(&eq.nodes_xyz_m);
+    assert!(rms > 1e-4, "the perturbation moves the surface: {rms} m");
+    let ratio = set.ratio(&eq.edges_forces_n);
+    for tolerance in [1e-3, 1e-2] {
+        let surface_only = Gradient {
+            weight: 0.0,
+            layout_weight: 0.0,
+            surface_tolerance_m: tolerance,
+            ..Gradient::default()
+        };
+        let theta = surface_only.theta_of_q(&problem, &q);
+        let (j0, _) = surface_only
+            .objective_and_gradient(&problem, &theta)
+            .unwrap();
+        let expected = (rms / tolerance).powi(2);
+        assert!(
+            (j0 / expected - 1.0).abs() < 1e-9,
+            "ε = {tolerance} m: J = {j0}, (RMS/ε)² = {expected}"
+        );
+        let weight = 3.0;
+        let with_ratio = Gradient {
+            weight,
+            ..surface_only.clone()
+        };
+        let (j, _) = with_ratio.objective_and_gradient(&problem, &theta).unwrap();
+        let term = (j - j0) / weight;
+        let bias = 2.0 * (set.edges.len() as f64).ln() / with_ratio.sharpness;
+        assert!(
+            term <= ratio.ln() + 1e-12 && term >= ratio.ln() - bias,
+            "ratio term {term} against ln(Tmax/Tmin) = {}",
+            ratio.ln()
+        );
+    }
+}
+
 #[test]
 fn gradient_matches_central_differences_on_the_paraboloid() {
     let problem = common::front_problem(&common::scene("small-hex"));
