@@ -473,8 +473,8 @@ impl UniformitySolver for Gradient {
     }
 
     /// The ratio weight from 10⁻² to 10⁶: the surface term is in units of the
-    /// tolerance (1 mm by default), so 10⁻² holds the surface to a few µm and
-    /// 10⁶ lets it go by centimetres, whatever the scene.
+    /// tolerance (1 mm by default), so the range means the same on every
+    /// scene (on paper-26m: RMS 5e-6 mm at 10⁻², 33 mm at 10⁶).
     fn knob_range(&self, _problem: &UniformityProblem) -> Option<KnobRange> {
         Some(KnobRange {
             name: "weight",
