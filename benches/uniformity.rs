@@ -21,7 +21,10 @@
 //!   generated tied nets of `lp_independent`'s `hex5` kind, 428 and 4 208
 //!   nodes (`RINGMESH_BENCH_GRADIENT_RINGS=41,130` adds ≈ 10⁴ and 10⁵); the
 //!   ratio against `lp`'s, the surface RMS and the iterations of one solve
-//!   are printed beside the time.
+//!   are printed beside the time;
+//! * `gradient_sharpness` — the `gradient` solver on the 2 516-node tied net
+//!   (20 rings) at the soft max's sharpness 100, 300 and 1 000: what a sharper
+//!   ratio surrogate costs (printed as above).
 //!
 //! Run with `cargo bench --bench uniformity`.
 
@@ -175,21 +178,52 @@ fn gradient_independent(c: &mut Criterion) {
         let net = hexnet::HexNet::like_hex5(r);
         let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
         let nodes = p.network().n_nodes();
-        let optimum = Lp.solve(&p).map(|d| d.ratio).unwrap_or(f64::NAN);
-        // What a solve reaches, once, beside its time.
-        if let Ok(d) = Gradient::default().solve(&p) {
-            eprintln!(
-                "gradient_independent/{nodes}: ratio {:.4} ({:+.2} % of lp's {optimum:.4}), \
-                 surface RMS {:.3e} mm, {} L-BFGS iterations, {}",
-                d.ratio,
-                100.0 * (d.ratio / optimum - 1.0),
-                1e3 * d.surface_rms_m,
-                d.iterations,
-                ringmesh::report::json_name(&d.termination)
-            );
-        }
+        print_gradient_solve(
+            &format!("gradient_independent/{nodes}"),
+            &Gradient::default(),
+            &p,
+        );
         group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
             b.iter(|| Gradient::default().solve(p))
+        });
+    }
+    group.finish();
+}
+
+/// What one `solver` solve of `p` reaches, printed beside the benchmark's time:
+/// the ratio against `lp`'s optimum, the surface RMS, the L-BFGS iterations
+/// and the solve's time.
+fn print_gradient_solve(id: &str, solver: &Gradient, p: &UniformityProblem) {
+    let optimum = Lp.solve(p).map(|d| d.ratio).unwrap_or(f64::NAN);
+    if let Ok(d) = solver.solve(p) {
+        eprintln!(
+            "{id}: ratio {:.4} ({:+.2} % of lp's {optimum:.4}), surface RMS {:.3e} mm, \
+             {} L-BFGS iterations, {}, {:.2} s",
+            d.ratio,
+            100.0 * (d.ratio / optimum - 1.0),
+            1e3 * d.surface_rms_m,
+            d.iterations,
+            ringmesh::report::json_name(&d.termination),
+            d.time_s
+        );
+    }
+}
+
+/// The sharpness of the soft max/min against time and iterations on a net
+/// where the default (1 000) needs thousands of L-BFGS iterations.
+fn gradient_sharpness(c: &mut Criterion) {
+    let net = hexnet::HexNet::like_hex5(20);
+    let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
+    let mut group = c.benchmark_group("gradient_sharpness");
+    group.sample_size(10);
+    for sharpness in [100.0, 300.0, 1000.0] {
+        let solver = Gradient {
+            sharpness,
+            ..Gradient::default()
+        };
+        print_gradient_solve(&format!("gradient_sharpness/{sharpness}"), &solver, &p);
+        group.bench_with_input(BenchmarkId::from_parameter(sharpness), &p, |b, p| {
+            b.iter(|| solver.solve(p))
         });
     }
     group.finish();
@@ -202,6 +236,7 @@ criterion_group!(
     lp_nodes,
     lp_independent,
     gradient_nodes,
-    gradient_independent
+    gradient_independent,
+    gradient_sharpness
 );
 criterion_main!(benches);
