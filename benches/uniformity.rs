@@ -24,7 +24,10 @@
 //!   are printed beside the time;
 //! * `gradient_sharpness` — the `gradient` solver on the 2 516-node tied net
 //!   (20 rings) at the soft max's sharpness 100, 300 and 1 000: what a sharper
-//!   ratio surrogate costs (printed as above).
+//!   ratio surrogate costs (printed as above);
+//! * `gradient_exact` — `gradient-exact` (the exact finish: sequential QPs on
+//!   the unsmoothed ratio) on the 428- and 2 516-node tied nets, printed as
+//!   above with the exact objective beside the smoothed solve's.
 //!
 //! Run with `cargo bench --bench uniformity`.
 
@@ -191,14 +194,16 @@ fn gradient_independent(c: &mut Criterion) {
 }
 
 /// What one `solver` solve of `p` reaches, printed beside the benchmark's time:
-/// the ratio against `lp`'s optimum, the surface RMS, the L-BFGS iterations
-/// and the solve's time.
+/// the ratio against `lp`'s optimum, the surface RMS, the iterations (L-BFGS
+/// iterations plus the exact finish's programs), the objective with the exact
+/// ratio and the solve's time.
 fn print_gradient_solve(id: &str, solver: &Gradient, p: &UniformityProblem) {
     let optimum = Lp.solve(p).map(|d| d.ratio).unwrap_or(f64::NAN);
     if let Ok(d) = solver.solve(p) {
+        let exact = solver.exact_objective(p, &d.q).unwrap_or(f64::NAN);
         eprintln!(
             "{id}: ratio {:.4} ({:+.2} % of lp's {optimum:.4}), surface RMS {:.3e} mm, \
-             {} L-BFGS iterations, {}, {:.2} s",
+             {} iterations, {}, exact J {exact:.8}, {:.2} s",
             d.ratio,
             100.0 * (d.ratio / optimum - 1.0),
             1e3 * d.surface_rms_m,
@@ -207,6 +212,26 @@ fn print_gradient_solve(id: &str, solver: &Gradient, p: &UniformityProblem) {
             d.time_s
         );
     }
+}
+
+/// The exact finish against the smoothed solve on the tied nets.
+fn gradient_exact(c: &mut Criterion) {
+    let mut group = c.benchmark_group("gradient_exact");
+    group.sample_size(10);
+    for r in [8, 20] {
+        let net = hexnet::HexNet::like_hex5(r);
+        let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
+        let nodes = p.network().n_nodes();
+        let solver = Gradient {
+            exact_finish: true,
+            ..Gradient::default()
+        };
+        print_gradient_solve(&format!("gradient_exact/{nodes}"), &solver, &p);
+        group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
+            b.iter(|| solver.solve(p))
+        });
+    }
+    group.finish();
 }
 
 /// The sharpness of the soft max/min against time and iterations on a net
@@ -237,6 +262,7 @@ criterion_group!(
     lp_independent,
     gradient_nodes,
     gradient_independent,
-    gradient_sharpness
+    gradient_sharpness,
+    gradient_exact
 );
 criterion_main!(benches);

@@ -395,3 +395,131 @@ fn the_gradient_front_is_monotone() {
     // at the other.
     assert!(front[0].ratio > 1.18 && front[9].ratio < 1.01, "{front:?}");
 }
+
+/// The 3-ring paper-26m front net with `[q]` lifted, and the 428-node
+/// independently generated tied net of the benches.
+fn finish_problems() -> Vec<(String, UniformityProblem)> {
+    let mut paper = common::scene("paper-26m");
+    paper.front_net.rings = 3;
+    paper.cables.max_force_density_n_per_m = 1e9;
+    let net = common::hexnet::HexNet::like_hex5(8).build();
+    vec![
+        ("paper-26m/3".into(), common::front_problem(&paper)),
+        (
+            "hex5/428".into(),
+            common::hexnet::tied_net_problem(net, "hangers", 50.0, 1e9),
+        ),
+    ]
+}
+
+/// The exact finish lands on the minimum of the nonsmooth objective: from
+/// three starts — `lp`'s fixed-geometry optimum (the default), the smoothed
+/// solve's end point, and the uniform-tension guess without L-BFGS — it
+/// ends at one exact `J` to 1e-8, below both `lp`'s design's and the
+/// smoothed solve's (whose soft max trades the largest tension for the
+/// spread of the next ones), in at most ten quadratic programs.
+#[test]
+fn exact_finish_lands_on_the_true_minimum() {
+    for (name, problem) in finish_problems() {
+        let exact = Gradient {
+            exact_finish: true,
+            ..Gradient::default()
+        };
+        let lp = Lp.solve(&problem).unwrap();
+        let j_lp = exact.exact_objective(&problem, &lp.q).unwrap();
+        let smoothed = Gradient::default().solve(&problem).unwrap();
+        let j_smoothed = exact.exact_objective(&problem, &smoothed.q).unwrap();
+        let starts = [
+            ("lp", exact.clone()),
+            (
+                "smoothed",
+                Gradient {
+                    optimum_start: false,
+                    ..exact.clone()
+                },
+            ),
+            (
+                "guess",
+                Gradient {
+                    optimum_start: false,
+                    max_iterations: 0,
+                    ..exact.clone()
+                },
+            ),
+        ];
+        let mut reached = Vec::new();
+        for (start, solver) in starts {
+            let (design, history) = match start {
+                "smoothed" => solver.solve_history_from(&problem, Some(&smoothed.q)),
+                _ => solver.solve_with_history(&problem),
+            }
+            .unwrap();
+            assert_eq!(
+                design.termination,
+                Termination::Converged,
+                "{name} from {start}: {:?}",
+                design.warnings
+            );
+            assert!(
+                (1..=10).contains(&history.finish_steps),
+                "{name} from {start}: {} steps",
+                history.finish_steps
+            );
+            let j = exact.exact_objective(&problem, &design.q).unwrap();
+            assert_eq!(history.exact_objective, Some(j), "{name} from {start}");
+            assert!(
+                j < j_lp && j < j_smoothed,
+                "{name} from {start}: {j} vs lp {j_lp}, smoothed {j_smoothed}"
+            );
+            reached.push(j);
+        }
+        let spread = reached
+            .iter()
+            .fold(0.0_f64, |a, &j| a.max((j / reached[0] - 1.0).abs()));
+        assert!(spread <= 1e-8, "{name}: {reached:?}");
+    }
+}
+
+/// With the geometry held (weight 1e-2) the exact finish from the
+/// uniform-tension guess, without L-BFGS, is `lp`'s optimum on small-hex
+/// and the 3-ring paper-26m: the same ratio to 1e-5 (two independent
+/// solvers of one problem), the surface within 1e-5 mm. (On the tied
+/// net a weight of 1e-2 still buys 1e-4 of ratio with the surface.)
+#[test]
+fn exact_finish_with_the_geometry_held_is_the_lp_optimum() {
+    let mut problems = finish_problems();
+    problems.truncate(1);
+    problems.push((
+        "small-hex".into(),
+        common::front_problem(&common::scene("small-hex")),
+    ));
+    for (name, problem) in problems {
+        let lp = Lp.solve(&problem).unwrap();
+        let design = Gradient {
+            weight: 1e-2,
+            optimum_start: false,
+            max_iterations: 0,
+            exact_finish: true,
+            ..Gradient::default()
+        }
+        .solve(&problem)
+        .unwrap();
+        assert_eq!(
+            design.termination,
+            Termination::Converged,
+            "{name}: {:?}",
+            design.warnings
+        );
+        assert!(
+            (design.ratio / lp.ratio - 1.0).abs() <= 1e-5,
+            "{name}: ratio {} vs LP {}",
+            design.ratio,
+            lp.ratio
+        );
+        assert!(
+            design.surface_rms_m <= 1e-8,
+            "{name}: {:e} m",
+            design.surface_rms_m
+        );
+    }
+}

@@ -185,6 +185,9 @@ pub enum SolverKind {
     Lp,
     /// Free-geometry adjoint L-BFGS (argmin).
     Gradient,
+    /// `gradient` with its exact finish: sequential QPs (clarabel) on the
+    /// unsmoothed `ln(Tmax/Tmin)`, the true minimiser for the weight.
+    GradientExact,
     /// Constrained or Tikhonov least squares (faer).
     LeastSquares,
 }
@@ -207,7 +210,7 @@ impl SolverKind {
     /// ([`UniformitySolver::solve_from`]); the others solve every problem
     /// afresh.
     pub fn warm_starts(self) -> bool {
-        matches!(self, SolverKind::Gradient)
+        matches!(self, SolverKind::Gradient | SolverKind::GradientExact)
     }
 
     /// The solver with its default settings, or with its accuracy knob set.
@@ -218,13 +221,16 @@ impl SolverKind {
                 ..Bisection::default()
             }),
             SolverKind::Lp => Box::new(Lp),
-            SolverKind::Gradient => Box::new(match knob {
-                Some(weight) => Gradient {
-                    weight,
+            SolverKind::Gradient | SolverKind::GradientExact => {
+                let defaults = Gradient {
+                    exact_finish: self == SolverKind::GradientExact,
                     ..Gradient::default()
-                },
-                None => Gradient::default(),
-            }),
+                };
+                Box::new(Gradient {
+                    weight: knob.unwrap_or(defaults.weight),
+                    ..defaults
+                })
+            }
             SolverKind::LeastSquares => Box::new(LeastSquares {
                 lambda: knob,
                 ..LeastSquares::default()

@@ -31,26 +31,43 @@ pub(super) fn soft_max(s: &[f64], beta: f64, weights: &mut [f64]) -> f64 {
     top + (sum / s.len() as f64).ln() / beta
 }
 
+/// `max s`, and the indicator of its first arg max written into `weights`
+/// (a subgradient); the signature of [`soft_max`], the sharpness unused.
+fn arg_max(s: &[f64], _beta: f64, weights: &mut [f64]) -> f64 {
+    let (top, value) = s
+        .iter()
+        .copied()
+        .enumerate()
+        .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+    weights.fill(0.0);
+    weights[top] = 1.0;
+    value
+}
+
 /// The objective of one problem with one set of settings.
 #[derive(Clone)]
 pub(super) struct Objective<'a> {
-    problem: &'a UniformityProblem,
+    pub(super) problem: &'a UniformityProblem,
     pub(super) map: Map,
-    weight: f64,
-    layout_weight: f64,
+    pub(super) weight: f64,
+    pub(super) layout_weight: f64,
     sharpness: f64,
+    /// The ratio term is the max/min themselves, not their soft versions:
+    /// the objective the surrogate smooths (values only; its gradient is a
+    /// subgradient).
+    exact: bool,
     /// `κ / LEVEL_UNIT²`.
-    level_weight: f64,
+    pub(super) level_weight: f64,
     /// `ν / BARRIER_UNIT³`.
     barrier_weight: f64,
     /// `1/(n_s ε²)`.
-    surface_scale: f64,
+    pub(super) surface_scale: f64,
     /// Free nodes that are not surface nodes.
-    other_free: Vec<usize>,
+    pub(super) other_free: Vec<usize>,
     /// Lower edge `q̲_k` of the barrier's box.
-    q_low: Vec<f64>,
+    pub(super) q_low: Vec<f64>,
     /// Upper edge `q̄` of the barrier's box.
-    q_high: f64,
+    pub(super) q_high: f64,
 }
 
 impl<'a> Objective<'a> {
@@ -69,6 +86,7 @@ impl<'a> Objective<'a> {
             weight: settings.weight,
             layout_weight: settings.layout_weight,
             sharpness: settings.sharpness,
+            exact: false,
             level_weight: settings.level_weight / (LEVEL_UNIT * LEVEL_UNIT),
             barrier_weight: settings.barrier_weight / BARRIER_UNIT.powi(3),
             surface_scale: 1.0 / (n_surface * tolerance * tolerance),
@@ -88,6 +106,14 @@ impl<'a> Objective<'a> {
     pub(super) fn with_sharpness(&self, sharpness: f64) -> Self {
         Objective {
             sharpness,
+            ..self.clone()
+        }
+    }
+
+    /// The same objective with the exact ratio term `ln(Tmax/Tmin)` per set.
+    pub(super) fn exact(&self) -> Self {
+        Objective {
+            exact: true,
             ..self.clone()
         }
     }
@@ -183,11 +209,12 @@ impl<'a> Objective<'a> {
             );
             up.resize(s.len(), 0.0);
             down.resize(s.len(), 0.0);
-            let high = soft_max(&s, self.sharpness, &mut up);
+            let extreme = if self.exact { arg_max } else { soft_max };
+            let high = extreme(&s, self.sharpness, &mut up);
             for v in s.iter_mut() {
                 *v = -*v;
             }
-            let low = -soft_max(&s, self.sharpness, &mut down);
+            let low = -extreme(&s, self.sharpness, &mut down);
             value += self.weight * (high - low);
             for (n, &k) in set.edges.iter().enumerate() {
                 dj_dt[k] += self.weight * (up[n] - down[n]) / tensions[k];
