@@ -342,58 +342,73 @@ fn geometry_held_reaches_the_lp_optimum() {
     }
 }
 
-/// `design --solver gradient`'s loop converges to 1e-6 m on small-hex and
-/// paper-26m: each design starts from the last boundary's, so its `q`
+/// `design --solver gradient`'s loop (and `gradient-exact`'s) converges to
+/// 1e-6 m on small-hex and paper-26m: each design starts from the last boundary's, so its `q`
 /// moves smoothly with the boundary (issue 17: it stalled at 1e-5 m on
 /// paper-26m before).
 #[test]
 fn the_design_loop_converges_with_the_gradient_solver() {
-    for name in ["small-hex", "paper-26m"] {
-        let scene = common::scene(name);
-        let nets = SceneNets::new(&scene).unwrap();
-        let outcome = nets
-            .design_loop(
-                &scene,
-                &Gradient::default(),
-                TrussModel::Exact,
-                &LoopSettings::default(),
-                &mut |_| {},
-            )
-            .unwrap();
-        assert_eq!(
-            outcome.termination,
-            LoopTermination::Converged,
-            "{name}: {:?}",
-            outcome.history.last()
-        );
-        assert!(outcome.boundary_residual_m() <= 1e-6, "{name}");
+    for kind in [SolverKind::Gradient, SolverKind::GradientExact] {
+        let solver = kind.build(None);
+        for name in ["small-hex", "paper-26m"] {
+            let scene = common::scene(name);
+            let nets = SceneNets::new(&scene).unwrap();
+            let outcome = nets
+                .design_loop(
+                    &scene,
+                    solver.as_ref(),
+                    TrussModel::Exact,
+                    &LoopSettings::default(),
+                    &mut |_| {},
+                )
+                .unwrap();
+            assert_eq!(
+                outcome.termination,
+                LoopTermination::Converged,
+                "{name}, {kind:?}: {:?}",
+                outcome.history.last()
+            );
+            assert!(outcome.boundary_residual_m() <= 1e-6, "{name}, {kind:?}");
+        }
     }
 }
 
-/// The gradient front on small-hex is monotone: as the ratio's weight grows
-/// (the surface's loosens) the ratio never rises, each point started from
-/// its neighbour's design.
+/// The gradient fronts on small-hex (smoothed and exact) are monotone: as
+/// the ratio's weight grows (the surface's loosens) the ratio never rises,
+/// each point started from its neighbour's design.
 #[test]
 fn the_gradient_front_is_monotone() {
     let problem = common::front_problem(&common::scene("small-hex"));
-    let front = design_front(&problem, &[SolverKind::Gradient], 10, &|_| {});
-    assert_eq!(front.len(), 10);
-    for pair in front.windows(2) {
-        let (a, b) = (&pair[0], &pair[1]);
-        assert!(a.outcome.is_ok() && b.outcome.is_ok(), "{a:?} {b:?}");
-        assert!(b.knob > a.knob);
+    let front = design_front(
+        &problem,
+        &[SolverKind::Gradient, SolverKind::GradientExact],
+        10,
+        &|_| {},
+    );
+    assert_eq!(front.len(), 20);
+    for points in front.chunks(10) {
+        for pair in points.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            assert!(a.outcome.is_ok() && b.outcome.is_ok(), "{a:?} {b:?}");
+            assert_eq!(a.solver, b.solver);
+            assert!(b.knob > a.knob);
+            assert!(
+                b.ratio <= a.ratio * (1.0 + 1e-9),
+                "{:?}, weight {:e}: ratio {} after {} at {:e}",
+                b.solver,
+                b.knob,
+                b.ratio,
+                a.ratio,
+                a.knob
+            );
+        }
+        // The sweep spans the trade: near the optimum at one end, near
+        // uniform at the other.
         assert!(
-            b.ratio <= a.ratio * (1.0 + 1e-9),
-            "weight {:e}: ratio {} after {} at {:e}",
-            b.knob,
-            b.ratio,
-            a.ratio,
-            a.knob
+            points[0].ratio > 1.18 && points[9].ratio < 1.01,
+            "{points:?}"
         );
     }
-    // The sweep spans the trade: near the optimum at one end, near uniform
-    // at the other.
-    assert!(front[0].ratio > 1.18 && front[9].ratio < 1.01, "{front:?}");
 }
 
 /// The 3-ring paper-26m front net with `[q]` lifted, and the 428-node

@@ -173,7 +173,11 @@ fn boundary_node_on_a_straight_chord_is_reported_infeasible_by_name() {
     let problem =
         UniformityProblem::from_mesh(&mesh, &[(CableGroup::Front, 70.0)], 5000.0).unwrap();
     let gradient = Gradient::default();
-    let solvers: [&dyn UniformitySolver; 3] = [&Lp, &Bisection::default(), &gradient];
+    let exact = Gradient {
+        exact_finish: true,
+        ..Gradient::default()
+    };
+    let solvers: [&dyn UniformitySolver; 4] = [&Lp, &Bisection::default(), &gradient, &exact];
     for solver in solvers {
         // Infeasibility is a design's termination; a caller that needs a
         // design gets it as the error naming the nodes.
