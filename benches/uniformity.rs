@@ -27,7 +27,8 @@
 //!   ratio surrogate costs (printed as above);
 //! * `gradient_exact` — `gradient-exact` (the exact finish: sequential QPs on
 //!   the unsmoothed ratio) on the 428- and 2 516-node tied nets, printed as
-//!   above with the exact objective beside the smoothed solve's.
+//!   above (`RINGMESH_BENCH_EXACT_RINGS=26,41` adds 4 208 and 10 328 nodes,
+//!   ≈ 30 s and 110 s a solve).
 //!
 //! Run with `cargo bench --bench uniformity`.
 
@@ -218,7 +219,7 @@ fn print_gradient_solve(id: &str, solver: &Gradient, p: &UniformityProblem) {
 fn gradient_exact(c: &mut Criterion) {
     let mut group = c.benchmark_group("gradient_exact");
     group.sample_size(10);
-    for r in [8, 20] {
+    for r in with_extra(vec![8, 20], "RINGMESH_BENCH_EXACT_RINGS") {
         let net = hexnet::HexNet::like_hex5(r);
         let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
         let nodes = p.network().n_nodes();
