@@ -105,7 +105,7 @@
 //!
 //! The soft max's minimiser is not the objective's: it trades the largest
 //! tension for the spread of the next ones (on the benches' tied nets its
-//! `J` is 6e-5 … 5e-4 above the true minimum), and L-BFGS pays for a
+//! `J` is 6e-5 … 4e-3 above the true minimum), and L-BFGS pays for a
 //! sharper surrogate in iterations, about in proportion to `β`, following
 //! the cables at the extremes. With [`Gradient::exact_finish`] (the solver
 //! `gradient-exact`) the solve ends with sequential quadratic programs on
@@ -184,7 +184,8 @@ pub struct Gradient {
     /// objective, `ln(Tmax/Tmin)` in place of its soft form, to its
     /// stationarity (see [`finish`]): the true minimiser for the weight, in
     /// a few programs whatever the size, each far dearer than an L-BFGS
-    /// iteration. With `max_iterations = 0` it starts from the start point.
+    /// iteration. From a start near the optimum (`lp`'s, a neighbour's) or
+    /// with `max_iterations = 0` the programs start there, without L-BFGS.
     pub exact_finish: bool,
 }
 
