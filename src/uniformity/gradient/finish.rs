@@ -33,7 +33,7 @@
 //! linearised problem lowers `J_exact` further, a stationarity certificate of
 //! the nonsmooth problem that does not depend on the net's size.
 
-use super::objective::Objective;
+use super::objective::{pretension_level, Objective};
 use crate::uniformity::conic::{Class, Cone, ConicProgram};
 use crate::uniformity::{SurfaceTarget, Termination, UniformityError};
 
@@ -239,8 +239,7 @@ impl Model {
         // Level: v = Σ_k T_k δs_k / (n₀ T̄₀), the term κ'(L + v)².
         let first = &sets[0];
         let n0 = first.edges.len() as f64;
-        let mean = first.edges.iter().map(|&k| tensions[k]).sum::<f64>() / n0;
-        let level = (mean / first.mean_tension_n).ln();
+        let (mean, level) = pretension_level(problem, tensions);
         let mut row = vec![(at_v, 1.0)];
         for &k in &first.edges {
             row.extend(delta_s(k, -tensions[k] / (n0 * mean)));

@@ -44,6 +44,14 @@ fn arg_max(s: &[f64], _beta: f64, weights: &mut [f64]) -> f64 {
     value
 }
 
+/// The first set's mean tension `T̄₀` at the tensions `tensions`, and the
+/// level `ln(T̄₀/t₀)` the level term holds at zero.
+pub(super) fn pretension_level(problem: &UniformityProblem, tensions: &[f64]) -> (f64, f64) {
+    let first = &problem.sets()[0];
+    let mean = first.edges.iter().map(|&k| tensions[k]).sum::<f64>() / first.edges.len() as f64;
+    (mean, (mean / first.mean_tension_n).ln())
+}
+
 /// The objective of one problem with one set of settings.
 #[derive(Clone)]
 pub(super) struct Objective<'a> {
@@ -222,8 +230,7 @@ impl<'a> Objective<'a> {
         }
         let first = &problem.sets()[0];
         let n0 = first.edges.len() as f64;
-        let mean = first.edges.iter().map(|&k| tensions[k]).sum::<f64>() / n0;
-        let level = (mean / first.mean_tension_n).ln();
+        let (mean, level) = pretension_level(problem, tensions);
         value += self.level_weight * level * level;
         for &k in &first.edges {
             dj_dt[k] += 2.0 * self.level_weight * level / (n0 * mean);
