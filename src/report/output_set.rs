@@ -37,9 +37,24 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Longest file name most file systems take, bytes.
 const NAME_MAX: usize = 255;
 
-/// Registers `path` for removal on interruption.
-pub(super) fn register(path: &Path) {
-    lock_pending().push(path.to_path_buf());
+/// Creates the temporary file `path` (and its folder, if missing),
+/// registered for removal on interruption. Registry, folder and file are
+/// made under the registry's lock: a signal handler, which holds that lock
+/// until the process exits, either finds them all and removes them, or
+/// none is created — a folder made after its removal would outlive the run.
+pub(super) fn create_registered(path: &Path) -> io::Result<File> {
+    let mut pending = lock_pending();
+    pending.push(path.to_path_buf());
+    let created = (|| {
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            fs::create_dir_all(parent)?;
+        }
+        File::create(path)
+    })();
+    if created.is_err() {
+        pending.retain(|p| p != path);
+    }
+    created
 }
 
 /// Forgets `path` (written, renamed or removed).
@@ -54,8 +69,9 @@ fn lock_pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 /// Removes every staging folder and temporary file this process has open
 /// and exits with `code`: for a signal handler. Waits for a set being
 /// swapped in to finish, and holds the registry until the exit, so that no
-/// new write begins; a write already under way may still create a file in
-/// a folder being removed, so each removal is retried until it holds.
+/// new file or folder is created ([`create_registered`]); a write already
+/// under way may still rename or link a file into a folder being removed,
+/// so each removal is retried until it holds.
 pub fn abandon_all_and_exit(code: i32) -> ! {
     let pending = lock_pending();
     for path in pending.iter() {
@@ -152,10 +168,14 @@ impl OutputSet {
         }
         let run_id = new_run_id();
         let staging = parent.join(format!("{prefix}{run_id}"));
-        register(&staging);
-        if let Err(e) = fs::create_dir(&staging) {
-            unregister(&staging);
-            return Err(unwritable_at(&staging)(e));
+        // Registered and created under the registry's lock, as in
+        // `create_registered`.
+        {
+            let mut pending = lock_pending();
+            if let Err(e) = fs::create_dir(&staging) {
+                return Err(unwritable_at(&staging)(e));
+            }
+            pending.push(staging.clone());
         }
         Ok(OutputSet {
             target,
