@@ -1,0 +1,244 @@
+//! The exact finish ([`super::Gradient::exact_finish`]): sequential quadratic
+//! programming on the objective the soft max/min smooths,
+//!
+//! $$J_{\text{exact}} = \frac{1}{n_s}\Big(\sum_i \frac{e_i^2}{ε^2} + λ_{\text{lay}}
+//!   \sum_i \frac{d_i^2}{ε^2}\Big) + w \sum_g \ln\frac{T_{\max,g}}{T_{\min,g}}
+//!   + κ \Big(\frac{\ln(\bar T_0/t_0)}{10^{-3}}\Big)^2 ,$$
+//!
+//! nonsmooth at every change of the cables at a set's extremes, where L-BFGS on
+//! the smoothed objective spends its iterations. Each step linearises, about
+//! the forward equilibrium `x(q)`, the equilibrium of the free nodes (eq. 2:
+//! `δq_k u_k + q_k (δx_i − δx_j)` summed at each free node is zero), the
+//! surface errors (Gauss–Newton) and `s_k = ln(T_k/t_g)`,
+//!
+//! $$δs_k = δq_k/q_k + u_k·(δx_i − δx_j)/ℓ_k^2 ,$$
+//!
+//! and solves, with clarabel, the quadratic program in `(δq, δx, ē, v, u_g, l_g)`
+//!
+//! $$\min\ \frac{1}{n_s ε^2}\Big(\sum ē^2 + λ_{\text{lay}}\sum (d + δx)^2\Big)
+//!   \;+\; w \sum_g (u_g − l_g) \;+\; κ' (L + v)^2
+//!   \quad\text{s.t.}\quad l_g ≤ s_k + δs_k ≤ u_g,$$
+//!
+//! the linearised equilibrium, `ē = e + ∇e·δx`, `v` the linearised change of
+//! `ln T̄₀`, the box `f t₀/ℓ̂_k ≤ q_k + δq_k ≤ 0.99 [q]` (the barrier's) and the
+//! trust region `|δq_k| ≤ r q_k`. The max/min enter exactly, as the bounds
+//! `u_g`, `l_g` of every cable of the set: the step sees which cables are at
+//! the extremes, as `lp` does, and the geometry's reply to `δq` at once.
+//!
+//! The step is taken on `q` alone (the geometry follows by a forward solve)
+//! when `J_exact` falls by more than a tenth of the decrease the model
+//! predicts; the radius doubles (to at most ½) when the model predicts well
+//! and shrinks ×4 when it does not. The finish has converged when the model
+//! predicts a decrease of at most [`FINISH_TOLERANCE`]`·J`: no step of the
+//! linearised problem lowers `J_exact` further, a stationarity certificate of
+//! the nonsmooth problem that does not depend on the net's size.
+
+mod model;
+
+use super::objective::{pretension_level, Objective};
+use crate::fdm::NONE;
+use crate::uniformity::{SurfaceTarget, Termination, UniformityError};
+use model::{Cable, ErrorRow, StepModel};
+
+/// The step's optimum `z`: clarabel for now.
+fn solve(model: &StepModel) -> Option<Vec<f64>> {
+    model.solve_with_clarabel()
+}
+
+/// The finish has converged when the model's predicted decrease is at most
+/// this times `J_exact`.
+pub(super) const FINISH_TOLERANCE: f64 = 1e-9;
+/// Most steps (quadratic programs) of the finish.
+pub(super) const MAX_FINISH_STEPS: usize = 50;
+/// The first trust radius, relative change of `q`.
+const FIRST_RADIUS: f64 = 0.05;
+/// The largest trust radius (`q` stays above half its value at a step).
+const MAX_RADIUS: f64 = 0.5;
+/// Below this radius a rejected step ends the finish.
+const MIN_RADIUS: f64 = 1e-9;
+
+/// What the finish returns.
+pub(super) struct Finished {
+    /// The last accepted force densities.
+    pub(super) q: Vec<f64>,
+    /// `J_exact` there.
+    pub(super) objective: f64,
+    /// Quadratic programs solved.
+    pub(super) steps: usize,
+    pub(super) termination: Termination,
+    pub(super) warnings: Vec<String>,
+}
+
+/// Sequential QP steps on `J_exact` from `q0` (see the module documentation).
+pub(super) fn finish(objective: &Objective, q0: &[f64]) -> Result<Finished, UniformityError> {
+    let exact = objective.exact();
+    let mut q = q0.to_vec();
+    let mut j = exact.evaluate_q(&q)?.0;
+    let mut radius = FIRST_RADIUS;
+    let mut warnings = Vec::new();
+    let mut steps = 0;
+    let termination = loop {
+        if steps == MAX_FINISH_STEPS {
+            warnings.push(format!(
+                "the exact finish did not converge in {MAX_FINISH_STEPS} steps"
+            ));
+            break Termination::MaxIterations;
+        }
+        steps += 1;
+        let model = step_model(objective, &q, radius)?;
+        let Some(z) = solve(&model) else {
+            warnings.push(format!(
+                "the exact finish stopped: its quadratic program failed at step {steps}"
+            ));
+            break Termination::Stalled;
+        };
+        let predicted = j - model.value(&z);
+        if predicted <= FINISH_TOLERANCE * j.abs() {
+            break Termination::Converged;
+        }
+        let trial: Vec<f64> = q
+            .iter()
+            .zip(&z)
+            .zip(&model.cables)
+            .map(|((&q, &p), cable)| q * (1.0 + p.clamp(cable.lo, cable.hi)))
+            .collect();
+        // A trial whose forward solve fails is a rejected step.
+        let j_trial = exact.evaluate_q(&trial).map_or(f64::INFINITY, |(v, _)| v);
+        let agreement = (j - j_trial) / predicted;
+        if agreement > 0.1 {
+            q = trial;
+            j = j_trial;
+            if agreement > 0.75 {
+                radius = (2.0 * radius).min(MAX_RADIUS);
+            }
+        } else {
+            radius *= 0.25;
+            if radius < MIN_RADIUS {
+                warnings.push(format!(
+                    "the exact finish stopped: no step within the trust radius lowers J \
+                     (the model predicts {predicted:.2e})"
+                ));
+                break Termination::Stalled;
+            }
+        }
+    };
+    Ok(Finished {
+        q,
+        objective: j,
+        steps,
+        termination,
+        warnings,
+    })
+}
+
+/// The quadratic model of `J_exact` about `q` with the trust radius `radius`.
+fn step_model(objective: &Objective, q: &[f64], radius: f64) -> Result<StepModel, UniformityError> {
+    let problem = objective.problem;
+    let structure = problem.structure();
+    let design = &problem.network().nodes;
+    let eq = problem.forward(q)?;
+    let x = &eq.nodes_xyz_m;
+    let tensions = &eq.edges_forces_n;
+    let free = |i: usize| structure.free_index(i).unwrap_or(NONE);
+    let n_free = structure.free_nodes().len();
+    let mut row_sum = vec![0.0; n_free];
+    let cables: Vec<Cable> = structure
+        .edges()
+        .iter()
+        .enumerate()
+        .map(|(k, &[a, b])| {
+            let ends = [free(a), free(b)];
+            for &f in &ends {
+                if f != NONE {
+                    row_sum[f] += q[k];
+                }
+            }
+            let u = eq.edges_vectors_m[k];
+            let l2 = eq.edges_lengths_m[k].powi(2);
+            let reach = radius * q[k];
+            let lo = (objective.q_low[k] - q[k]).clamp(-reach, reach);
+            let hi = (objective.q_high - q[k]).clamp(lo, reach);
+            Cable {
+                ends,
+                q: q[k],
+                u,
+                g: u.map(|c| c / l2),
+                lo: lo / q[k],
+                hi: hi / q[k],
+            }
+        })
+        .collect();
+
+    // Surface errors ē = e + ∇e·ξ, and the layout drift.
+    let mut errors = Vec::new();
+    let mut drifts = Vec::new();
+    let drift = |i: usize, d: usize| (3 * free(i) + d, x[i][d] - design[i][d]);
+    for &i in problem.surface_nodes() {
+        let point = x[i];
+        match problem.surface() {
+            SurfaceTarget::Paraboloid(parab) => {
+                let two_f = 2.0 * parab.focal_length_m;
+                errors.push(ErrorRow {
+                    node: free(i),
+                    gradient: [-point[0] / two_f, -point[1] / two_f, 1.0],
+                    value: parab.axial_deviation(point),
+                });
+                if free(i) != NONE {
+                    drifts.extend((0..2).map(|d| drift(i, d)));
+                }
+            }
+            SurfaceTarget::Prescribed => {
+                for d in 0..3 {
+                    let mut gradient = [0.0; 3];
+                    gradient[d] = 1.0;
+                    errors.push(ErrorRow {
+                        node: free(i),
+                        gradient,
+                        value: point[d] - design[i][d],
+                    });
+                }
+            }
+        }
+    }
+    for &i in &objective.other_free {
+        if free(i) != NONE {
+            drifts.extend((0..3).map(|d| drift(i, d)));
+        }
+    }
+    let drift_weight = objective.layout_weight * objective.surface_scale;
+    if drift_weight == 0.0 {
+        drifts.clear();
+    }
+
+    // The level v = Σ_k T_k δs_k / (n₀ T̄₀) of the first set.
+    let sets = problem.sets();
+    let first = &sets[0];
+    let n0 = first.edges.len() as f64;
+    let (mean, level) = pretension_level(problem, tensions);
+    Ok(StepModel {
+        cables,
+        n_free,
+        row_scale: row_sum.iter().map(|&s| if s > 0.0 { 1.0 / s } else { 1.0 }).collect(),
+        errors,
+        error_weight: objective.surface_scale,
+        drifts,
+        drift_weight,
+        sets: sets
+            .iter()
+            .map(|set| {
+                set.edges
+                    .iter()
+                    .map(|&k| (k, (tensions[k] / set.mean_tension_n).ln()))
+                    .collect()
+            })
+            .collect(),
+        weight: objective.weight,
+        level_terms: first
+            .edges
+            .iter()
+            .map(|&k| (k, tensions[k] / (n0 * mean)))
+            .collect(),
+        level_weight: objective.level_weight,
+        level,
+    })
+}
