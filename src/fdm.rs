@@ -643,6 +643,26 @@ impl Equilibrium {
         self.edges_forces_n.iter().copied().fold(0.0, f64::max)
     }
 
+    /// Solves `D x = rhs` in place for the three columns of `rhs` (one row
+    /// per free node, in free order) with this equilibrium's factor of `D`
+    /// (eq. 3–4); `rhs` is left as it is when no node is free.
+    ///
+    /// # Panics
+    /// If `rhs` has not one row per free node of the factored `D`.
+    #[track_caller]
+    pub fn solve_d(&self, rhs: &mut [[f64; 3]]) {
+        let Some(factor) = &self.factor else {
+            return;
+        };
+        let n_free = rhs.len();
+        let mut x = Mat::<f64>::from_fn(n_free, 3, |f, c| rhs[f][c]);
+        let mut buffer = MemBuffer::new(factor.symbolic.solve_in_place_scratch::<f64>(3, PAR));
+        factor.solve_in_place(x.as_mut(), MemStack::new(&mut buffer));
+        for (f, row) in rhs.iter_mut().enumerate() {
+            *row = [x[(f, 0)], x[(f, 1)], x[(f, 2)]];
+        }
+    }
+
     /// Adjoint sensitivities of an objective `J(x_f, q)` (DESIGN §3): solves
     /// `D λ = ∂J/∂x_f` with the factor already at hand, then
     /// `dJ/dq_k = ∂J/∂q_k − Σ_c (C_f λ_c)_k u_{k,c}`.

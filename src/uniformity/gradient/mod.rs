@@ -113,8 +113,8 @@
 //! from `lp`'s optimum or a neighbour's design, whatever the size, to a
 //! stationarity certificate of the nonsmooth problem. L-BFGS then runs only
 //! from a far start (the uniform-tension guess), to bring it near. Each
-//! program is a sparse clarabel solve of the size of the net, so the finish
-//! costs more than the smoothed solve on most nets.
+//! program is solved by an interior point on the net's structure (one
+//! sparse LDLᵀ of the node graph in 6×6 blocks an iteration).
 
 mod finish;
 mod lbfgs;

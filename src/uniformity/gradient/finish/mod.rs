@@ -13,7 +13,8 @@
 //!
 //! $$δs_k = δq_k/q_k + u_k·(δx_i − δx_j)/ℓ_k^2 ,$$
 //!
-//! and solves, with clarabel, the quadratic program in `(δq, δx, ē, v, u_g, l_g)`
+//! and solves the quadratic program in `(δq, δx, u_g, l_g)` (`model.rs`: `ē`
+//! and `v` below are linear in them)
 //!
 //! $$\min\ \frac{1}{n_s ε^2}\Big(\sum ē^2 + λ_{\text{lay}}\sum (d + δx)^2\Big)
 //!   \;+\; w \sum_g (u_g − l_g) \;+\; κ' (L + v)^2
@@ -32,17 +33,44 @@
 //! predicts a decrease of at most [`FINISH_TOLERANCE`]`·J`: no step of the
 //! linearised problem lowers `J_exact` further, a stationarity certificate of
 //! the nonsmooth problem that does not depend on the net's size.
+//!
+//! The program is solved by an interior point on its structure (`ipm.rs`,
+//! with the Newton systems reduced to the node graph in `kkt.rs`): 10–14
+//! iterations of one sparse LDLᵀ of `6 n_free` unknowns each, 3–4× faster
+//! than clarabel on the program stated generically (the 10⁴-node tied net:
+//! ≈ 5 s a program against 27 s). clarabel remains the fallback, and the
+//! cross-check of the tests. Either solver's point is made feasible before
+//! its value is read ([`StepModel::feasible_point`]).
 
+mod ipm;
+mod kkt;
 mod model;
 
 use super::objective::{pretension_level, Objective};
-use crate::fdm::NONE;
+use crate::fdm::{Equilibrium, NONE};
 use crate::uniformity::{SurfaceTarget, Termination, UniformityError};
 use model::{Cable, ErrorRow, StepModel};
 
-/// The step's optimum `z`: clarabel for now.
-fn solve(model: &StepModel) -> Option<Vec<f64>> {
-    model.solve_with_clarabel()
+/// The step's optimum `z` at a feasible point (see
+/// [`StepModel::feasible_point`]): the structured interior point
+/// (`ipm.rs`), clarabel where it fails (said in `warnings`).
+fn solve(
+    model: &StepModel,
+    eq: &Equilibrium,
+    step: usize,
+    warnings: &mut Vec<String>,
+) -> Option<Vec<f64>> {
+    let z = match ipm::solve(model) {
+        Ok(z) => z,
+        Err(why) => {
+            warnings.push(format!(
+                "the exact finish's interior point failed at step {step} ({why}); clarabel \
+                 solved the program"
+            ));
+            model.solve_with_clarabel()?
+        }
+    };
+    Some(model.feasible_point(&z, |rhs| eq.solve_d(rhs)))
 }
 
 /// The finish has converged when the model's predicted decrease is at most
@@ -85,8 +113,8 @@ pub(super) fn finish(objective: &Objective, q0: &[f64]) -> Result<Finished, Unif
             break Termination::MaxIterations;
         }
         steps += 1;
-        let model = step_model(objective, &q, radius)?;
-        let Some(z) = solve(&model) else {
+        let (model, eq) = step_model(objective, &q, radius)?;
+        let Some(z) = solve(&model, &eq, steps, &mut warnings) else {
             warnings.push(format!(
                 "the exact finish stopped: its quadratic program failed at step {steps}"
             ));
@@ -132,7 +160,11 @@ pub(super) fn finish(objective: &Objective, q0: &[f64]) -> Result<Finished, Unif
 }
 
 /// The quadratic model of `J_exact` about `q` with the trust radius `radius`.
-fn step_model(objective: &Objective, q: &[f64], radius: f64) -> Result<StepModel, UniformityError> {
+fn step_model(
+    objective: &Objective,
+    q: &[f64],
+    radius: f64,
+) -> Result<(StepModel, Equilibrium), UniformityError> {
     let problem = objective.problem;
     let structure = problem.structure();
     let design = &problem.network().nodes;
@@ -215,10 +247,13 @@ fn step_model(objective: &Objective, q: &[f64], radius: f64) -> Result<StepModel
     let first = &sets[0];
     let n0 = first.edges.len() as f64;
     let (mean, level) = pretension_level(problem, tensions);
-    Ok(StepModel {
+    let model = StepModel {
         cables,
         n_free,
-        row_scale: row_sum.iter().map(|&s| if s > 0.0 { 1.0 / s } else { 1.0 }).collect(),
+        row_scale: row_sum
+            .iter()
+            .map(|&s| if s > 0.0 { 1.0 / s } else { 1.0 })
+            .collect(),
         errors,
         error_weight: objective.surface_scale,
         drifts,
@@ -240,5 +275,9 @@ fn step_model(objective: &Objective, q: &[f64], radius: f64) -> Result<StepModel
             .collect(),
         level_weight: objective.level_weight,
         level,
-    })
+    };
+    Ok((model, eq))
 }
+
+#[cfg(test)]
+mod tests;

@@ -108,8 +108,15 @@ impl StepModel {
 
     /// Adds `factor ∂(δ ln T_k)/∂z` into `out`.
     pub(super) fn add_delta_s_gradient(&self, k: usize, factor: f64, out: &mut [f64]) {
-        for (i, v) in self.delta_s_entries(k) {
-            out[i] += factor * v;
+        let cable = &self.cables[k];
+        out[k] += factor;
+        for (end, sign) in cable.ends.iter().zip([1.0, -1.0]) {
+            if *end != NONE {
+                let at = self.at_xi() + 3 * end;
+                for d in 0..3 {
+                    out[at + d] += factor * sign * cable.g[d];
+                }
+            }
         }
     }
 
@@ -210,10 +217,7 @@ impl StepModel {
         out.fill(0.0);
         let at_xi = self.at_xi();
         for (k, cable) in self.cables.iter().enumerate() {
-            let mut f = [0.0; 3];
-            for d in 0..3 {
-                f[d] = cable.q * cable.u[d] * z[k];
-            }
+            let mut f = cable.u.map(|u| cable.q * u * z[k]);
             for (end, sign) in cable.ends.iter().zip([1.0, -1.0]) {
                 if *end != NONE {
                     for d in 0..3 {
@@ -253,6 +257,43 @@ impl StepModel {
                 }
             }
         }
+    }
+
+    /// The feasible point of `p`, the relative changes in `z`: `p` clamped
+    /// to its box, `ξ` the linearised equilibrium's answer to it (`D ξ =
+    /// −Σ_k ±q_k u_k p_k` at every free node, eq. 3–4, with `solve_d` solving
+    /// `D`), and `u_g`, `l_g` the extremes of `s_k + δs_k`. A solver meets
+    /// the rows to its tolerance only; the model's value at its point can lie
+    /// below the optimum by more than the finish's test (`10⁻⁹ J`) resolves,
+    /// which would read as a decrease that no step gives.
+    pub(super) fn feasible_point(&self, z: &[f64], solve_d: impl Fn(&mut [[f64; 3]])) -> Vec<f64> {
+        let mut z = z.to_vec();
+        let mut rhs = vec![[0.0; 3]; self.n_free];
+        for (k, cable) in self.cables.iter().enumerate() {
+            z[k] = z[k].clamp(cable.lo, cable.hi);
+            for (end, sign) in cable.ends.iter().zip([-1.0, 1.0]) {
+                if *end != NONE {
+                    for (r, u) in rhs[*end].iter_mut().zip(cable.u) {
+                        *r += sign * cable.q * u * z[k];
+                    }
+                }
+            }
+        }
+        solve_d(&mut rhs);
+        let at_xi = self.at_xi();
+        for (f, xi) in rhs.iter().enumerate() {
+            z[at_xi + 3 * f..at_xi + 3 * f + 3].copy_from_slice(xi);
+        }
+        let at = self.at_bounds();
+        for (g, set) in self.sets.iter().enumerate() {
+            let s = set.iter().map(|&(k, s)| s + self.delta_s(k, &z));
+            let (high, low) = s.fold((f64::NEG_INFINITY, f64::INFINITY), |(h, l), v| {
+                (h.max(v), l.min(v))
+            });
+            z[at + 2 * g] = high;
+            z[at + 2 * g + 1] = low;
+        }
+        z
     }
 
     /// The model as a generic conic program for clarabel: the variables `z`,
