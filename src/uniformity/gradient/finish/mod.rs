@@ -62,7 +62,9 @@ fn solve(
     step: usize,
     warnings: &mut Vec<String>,
 ) -> Option<Vec<f64>> {
-    let z = match ipm::solve(model, multipliers.as_deref()) {
+    let no_step = model.feasible_point(&vec![0.0; model.n()], |rhs| eq.solve_d(rhs));
+    let reference = model.value(&no_step);
+    let z = match ipm::solve(model, multipliers.as_deref(), reference) {
         Ok((z, lambda)) => {
             *multipliers = Some(lambda);
             z
