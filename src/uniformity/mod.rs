@@ -9,6 +9,7 @@
 //! | [`LeastSquares`] | `min ‖L q − T̄‖²` s.t. `A q = p`, or Tikhonov `λ` | λ |
 
 mod bisection;
+mod block_pattern;
 mod conic;
 mod design;
 mod front;

@@ -7,17 +7,14 @@
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::linalg::solvers::LltError;
-use faer::perm::PermRef;
-use faer::sparse::linalg::amd;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
-};
-use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
 use super::{IpmSettings, RatioLp};
 use crate::algebra::norm_inf;
-use crate::fdm::{d_sparsity, NONE};
+use crate::fdm::NONE;
+use crate::uniformity::block_pattern::{BlockPattern, PatternError};
 
 /// The factorisation and the solves run on one thread: on super-100m's plan
 /// LP (84 362 net nodes, 31 iterations) the interior point took 8.0 s with
@@ -32,12 +29,9 @@ pub(crate) enum NormalError {
     /// A workspace could not be allocated.
     #[error("out of memory for {0}")]
     OutOfMemory(&'static str),
-    /// The fill-reducing ordering of the node graph failed.
-    #[error("AMD ordering: {0:?}")]
-    Ordering(FaerError),
-    /// The symbolic Cholesky factorisation failed.
-    #[error("symbolic factorisation: {0:?}")]
-    Symbolic(FaerError),
+    /// The pattern, its ordering or its symbolic factorisation.
+    #[error(transparent)]
+    Pattern(#[from] PatternError),
     /// The numeric factorisation failed even with the largest diagonal shift.
     #[error("numeric factorisation with a diagonal shift of {shift:.1e}: {error:?}")]
     Numeric {
@@ -82,75 +76,12 @@ impl<const D: usize> NormalMatrix<D> {
             .map(|e| e.map(|i| i.unwrap_or(NONE)))
             .collect();
 
-        // The node graph is the pattern of `D = C_fᵀ Q C_f` (lower triangle, the
-        // diagonal first in each column); a fixed end maps to an extra node that
-        // is not free.
-        let free_index: Vec<usize> = (0..n_free).chain([NONE]).collect();
-        let node_edges: Vec<[usize; 2]> = ends
-            .iter()
-            .map(|e| e.map(|i| if i == NONE { n_free } else { i }))
-            .collect();
-        let (graph, slots) = d_sparsity(&node_edges, &free_index, n_free);
-        let (graph_ptr, graph_idx) = (graph.col_ptr(), graph.row_idx());
-        // A cable between free nodes: its place among the neighbours of its lower end.
-        let neighbour = ends
-            .iter()
-            .zip(&slots)
-            .map(|(&[a, b], slot)| {
-                if a == NONE || b == NONE {
-                    NONE
-                } else {
-                    slot.off_diagonal - graph_ptr[a.min(b)] - 1
-                }
-            })
-            .collect();
-        let neighbours = |f: usize| &graph_idx[graph_ptr[f] + 1..graph_ptr[f + 1]];
-
-        // Fill-reducing ordering of the node graph, expanded to the D×D blocks.
-        let mut perm = vec![0usize; n_free];
-        let mut perm_inv = vec![0usize; n_free];
-        {
-            let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n_free, graph_idx.len()))
-                .map_err(|_| NormalError::OutOfMemory("the AMD ordering"))?;
-            amd::order(
-                &mut perm,
-                &mut perm_inv,
-                graph.as_ref(),
-                amd::Control::default(),
-                MemStack::new(&mut mem),
-            )
-            .map_err(NormalError::Ordering)?;
-        }
-        let block_perm: Vec<usize> = (0..n_rows).map(|r| D * perm[r / D] + r % D).collect();
-        let block_perm_inv: Vec<usize> = (0..n_rows).map(|r| D * perm_inv[r / D] + r % D).collect();
-
-        // Pattern of M: column Df+c holds rows Df+c..Df+D of the diagonal block,
-        // then the D rows of each neighbour block, ascending.
-        let mut col_ptr = vec![0usize; n_rows + 1];
-        for f in 0..n_free {
-            let n_nb = neighbours(f).len();
-            for c in 0..D {
-                col_ptr[D * f + c + 1] = col_ptr[D * f + c] + (D - c) + D * n_nb;
-            }
-        }
-        let mut row_idx = Vec::with_capacity(col_ptr[n_rows]);
-        for f in 0..n_free {
-            for c in 0..D {
-                row_idx.extend(D * f + c..D * f + D);
-                for &r in neighbours(f) {
-                    row_idx.extend(D * r..D * r + D);
-                }
-            }
-        }
-        let pattern =
-            SymbolicSparseColMat::new_checked(n_rows, n_rows, col_ptr.clone(), None, row_idx);
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Custom(PermRef::new_checked(&block_perm, &block_perm_inv, n_rows)),
-            Default::default(),
-        )
-        .map_err(NormalError::Symbolic)?;
+        let BlockPattern {
+            neighbour,
+            col_ptr,
+            pattern,
+            symbolic,
+        } = BlockPattern::new(&ends, n_free, D)?;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(PAR, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, PAR),

@@ -17,7 +17,7 @@
 //! `p` is eliminated cable by cable (its block is diagonal); what is left on
 //! `(ξ, y)` is quasi-definite with the pattern of the node graph in 6×6
 //! blocks, `R = [Hξξ − Hξp h⁻¹ Hpξ, ·; E_ξ − E_p h⁻¹ Hpξ, −E_p h⁻¹ E_pᵀ]`, factored
-//! by faer's sparse LDLᵀ (AMD on the node graph, expanded blockwise;
+//! by faer's sparse LDLᵀ (pattern and ordering: `block_pattern.rs`;
 //! dynamic regularisation with the signs `+` on `ξ`, `−` on `y`); the border
 //! is eliminated with `nb` more solves and an `nb × nb` dense system. The
 //! `ξξ` part of one cable is `D_k d_k/h_k g gᵀ` — the difference
@@ -31,17 +31,14 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::perm::PermRef;
-use faer::sparse::linalg::amd;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LdltRef, SymbolicCholesky, SymmetricOrdering,
-};
+use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 use nalgebra::{DMatrix, DVector};
 
 use super::model::StepModel;
-use crate::fdm::{d_sparsity, NONE};
+use crate::fdm::NONE;
+use crate::uniformity::block_pattern::BlockPattern;
 
 /// Unknowns per free node in the reduced system: `ξ` (3), then `y` (3).
 const B: usize = 6;
@@ -99,74 +96,13 @@ impl<'a> Kkt<'a> {
     pub(super) fn new(model: &'a StepModel) -> Result<Self, KktError> {
         let n_free = model.n_free;
         let n_rows = B * n_free;
-        // The node graph, a fixed end mapped to an extra node that is not free.
-        let free_index: Vec<usize> = (0..n_free).chain([NONE]).collect();
-        let node_edges: Vec<[usize; 2]> = model
-            .cables
-            .iter()
-            .map(|c| c.ends.map(|f| if f == NONE { n_free } else { f }))
-            .collect();
-        let (graph, slots) = d_sparsity(&node_edges, &free_index, n_free);
-        let (graph_ptr, graph_idx) = (graph.col_ptr(), graph.row_idx());
-        let neighbour = model
-            .cables
-            .iter()
-            .zip(&slots)
-            .map(|(c, slot)| {
-                let [a, b] = c.ends;
-                if a == NONE || b == NONE || a == b {
-                    NONE
-                } else {
-                    slot.off_diagonal - graph_ptr[a.min(b)] - 1
-                }
-            })
-            .collect();
-        let neighbours = |f: usize| &graph_idx[graph_ptr[f] + 1..graph_ptr[f + 1]];
-
-        let mut perm = vec![0usize; n_free];
-        let mut perm_inv = vec![0usize; n_free];
-        {
-            let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n_free, graph_idx.len()))
-                .map_err(|_| KktError("out of memory for the AMD ordering".into()))?;
-            amd::order(
-                &mut perm,
-                &mut perm_inv,
-                graph.as_ref(),
-                amd::Control::default(),
-                MemStack::new(&mut mem),
-            )
-            .map_err(|e| KktError(format!("AMD ordering: {e:?}")))?;
-        }
-        let block_perm: Vec<usize> = (0..n_rows).map(|r| B * perm[r / B] + r % B).collect();
-        let block_perm_inv: Vec<usize> = (0..n_rows).map(|r| B * perm_inv[r / B] + r % B).collect();
-
-        // Column B f + c: rows B f + c .. B f + B of the diagonal block, then the
-        // B rows of each neighbour block, ascending.
-        let mut col_ptr = vec![0usize; n_rows + 1];
-        for f in 0..n_free {
-            let n_nb = neighbours(f).len();
-            for c in 0..B {
-                col_ptr[B * f + c + 1] = col_ptr[B * f + c] + (B - c) + B * n_nb;
-            }
-        }
-        let mut row_idx = Vec::with_capacity(col_ptr[n_rows]);
-        for f in 0..n_free {
-            for c in 0..B {
-                row_idx.extend(B * f + c..B * f + B);
-                for &r in neighbours(f) {
-                    row_idx.extend(B * r..B * r + B);
-                }
-            }
-        }
-        let pattern =
-            SymbolicSparseColMat::new_checked(n_rows, n_rows, col_ptr.clone(), None, row_idx);
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Custom(PermRef::new_checked(&block_perm, &block_perm_inv, n_rows)),
-            Default::default(),
-        )
-        .map_err(|e| KktError(format!("symbolic factorisation: {e:?}")))?;
+        let ends: Vec<[usize; 2]> = model.cables.iter().map(|c| c.ends).collect();
+        let BlockPattern {
+            neighbour,
+            col_ptr,
+            pattern,
+            symbolic,
+        } = BlockPattern::new(&ends, n_free, B).map_err(|e| KktError(e.to_string()))?;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_ldlt_scratch::<f64>(PAR, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(2 * model.sets.len() + 1, PAR),

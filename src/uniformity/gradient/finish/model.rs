@@ -160,25 +160,7 @@ impl StepModel {
 
     /// The gradient `Hz + c` of the model at `z`.
     pub(super) fn gradient(&self, z: &[f64]) -> Vec<f64> {
-        let at_xi = self.at_xi();
-        let mut out = vec![0.0; self.n()];
-        for row in &self.errors {
-            if row.node == NONE {
-                continue;
-            }
-            let at = at_xi + 3 * row.node;
-            let e = row.value + (0..3).map(|d| row.gradient[d] * z[at + d]).sum::<f64>();
-            for d in 0..3 {
-                out[at + d] += 2.0 * self.error_weight * e * row.gradient[d];
-            }
-        }
-        for &(column, drift) in &self.drifts {
-            out[at_xi + column] += 2.0 * self.drift_weight * (drift + z[at_xi + column]);
-        }
-        let level = 2.0 * self.level_weight * (self.level + self.level_change(z));
-        for &(k, w) in &self.level_terms {
-            self.add_delta_s_gradient(k, level * w, &mut out);
-        }
+        let mut out = self.quadratic_terms(z, 1.0);
         let at = self.at_bounds();
         for g in 0..self.sets.len() {
             out[at + 2 * g] += self.weight;
@@ -189,6 +171,13 @@ impl StepModel {
 
     /// The product `H v` of the model's Hessian.
     pub(super) fn hessian_mul(&self, v: &[f64]) -> Vec<f64> {
+        self.quadratic_terms(v, 0.0)
+    }
+
+    /// The gradient of the surface, drift and level terms at `z`, their
+    /// constant parts (`e`, the drift, `L`) times `constants`: `Hz + c` with
+    /// 1, `Hz` with 0.
+    fn quadratic_terms(&self, z: &[f64], constants: f64) -> Vec<f64> {
         let at_xi = self.at_xi();
         let mut out = vec![0.0; self.n()];
         for row in &self.errors {
@@ -196,15 +185,17 @@ impl StepModel {
                 continue;
             }
             let at = at_xi + 3 * row.node;
-            let e = (0..3).map(|d| row.gradient[d] * v[at + d]).sum::<f64>();
+            let e =
+                constants * row.value + (0..3).map(|d| row.gradient[d] * z[at + d]).sum::<f64>();
             for d in 0..3 {
                 out[at + d] += 2.0 * self.error_weight * e * row.gradient[d];
             }
         }
-        for &(column, _) in &self.drifts {
-            out[at_xi + column] += 2.0 * self.drift_weight * v[at_xi + column];
+        for &(column, drift) in &self.drifts {
+            out[at_xi + column] +=
+                2.0 * self.drift_weight * (constants * drift + z[at_xi + column]);
         }
-        let level = 2.0 * self.level_weight * self.level_change(v);
+        let level = 2.0 * self.level_weight * (constants * self.level + self.level_change(z));
         for &(k, w) in &self.level_terms {
             self.add_delta_s_gradient(k, level * w, &mut out);
         }
