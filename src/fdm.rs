@@ -693,19 +693,14 @@ impl Equilibrium {
             }
             None => vec![0.0; structure.n_edges()],
         };
-        let Some(factor) = &self.factor else {
-            return gradient;
-        };
-        let mut lambda =
-            Mat::<f64>::from_fn(structure.free.len(), 3, |f, c| dj_dx[structure.free[f]][c]);
-        let mut buffer = MemBuffer::new(factor.symbolic.solve_in_place_scratch::<f64>(3, PAR));
-        factor.solve_in_place(lambda.as_mut(), MemStack::new(&mut buffer));
+        let mut lambda: Vec<[f64; 3]> = structure.free.iter().map(|&i| dj_dx[i]).collect();
+        self.solve_d(&mut lambda);
         let lambda_of = |node: usize, c: usize| {
             let f = structure.free_index[node];
             if f == NONE {
                 0.0
             } else {
-                lambda[(f, c)]
+                lambda[f][c]
             }
         };
         for (k, (&[i, j], uk)) in structure

@@ -47,13 +47,13 @@ const STEP_FRACTION: f64 = 0.99;
 
 /// The program's optimum `z` and the multipliers `λ` of its rows, or why it
 /// was not reached. `warm`: the multipliers of the previous program of the
-/// same rows (the step before), the first `λ` where given; `reference`:
-/// the model's value with no step, against which [`COARSE`] measures the
-/// decrease (`−∞` solves to [`TOLERANCE`] always).
+/// same rows (the step before), the first `λ` where given; `coarse`: stop
+/// at [`COARSE`] times the decrease from the start (the step-free point)
+/// where that comes first, else always at [`TOLERANCE`].
 pub(super) fn solve(
     model: &StepModel,
     warm: Option<&[f64]>,
-    reference: f64,
+    coarse: bool,
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
     let rows = Rows::new(model);
     let mut kkt = Kkt::new(model).map_err(|e| e.0)?;
@@ -69,6 +69,12 @@ pub(super) fn solve(
         z[at + 2 * g] = s.clone().fold(f64::NEG_INFINITY, f64::max);
         z[at + 2 * g + 1] = s.fold(f64::INFINITY, f64::min);
     }
+    // The start is the step-free point, feasible but for the slacks.
+    let reference = if coarse {
+        model.value(&z)
+    } else {
+        f64::NEG_INFINITY
+    };
     let gz = rows.mul(&z);
     let mut s: Vec<f64> = rows
         .h

@@ -158,7 +158,6 @@ impl<'a> Kkt<'a> {
         self.factor_reduced()?;
 
         // The border: u_g, l_g of each set, then ω for the level term.
-        let at_xi = model.at_xi();
         let n_sparse = self.n_sparse();
         let mut border = Vec::new();
         let mut corner = Vec::new();
@@ -180,7 +179,6 @@ impl<'a> Kkt<'a> {
             border.push(column);
             corner.push(-0.5 / model.level_weight);
         }
-        debug_assert!(border.iter().all(|c| c[at_xi..].len() == n_sparse - m));
         let mut solved: Vec<f64> = border.concat();
         self.solve_sparse(&mut solved);
         let solved: Vec<Vec<f64>> = solved.chunks(n_sparse).map(<[f64]>::to_vec).collect();
@@ -195,7 +193,11 @@ impl<'a> Kkt<'a> {
         });
         self.border = border;
         self.border_solved = solved;
-        self.schur = Some(schur.lu());
+        let schur = schur.lu();
+        if !schur.is_invertible() {
+            return Err(KktError("the border's Schur complement is singular".into()));
+        }
+        self.schur = Some(schur);
         Ok(())
     }
 

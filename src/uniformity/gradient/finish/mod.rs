@@ -62,9 +62,7 @@ fn solve(
     step: usize,
     warnings: &mut Vec<String>,
 ) -> Option<Vec<f64>> {
-    let no_step = model.feasible_point(&vec![0.0; model.n()], |rhs| eq.solve_d(rhs));
-    let reference = model.value(&no_step);
-    let z = match ipm::solve(model, multipliers.as_deref(), reference) {
+    let z = match ipm::solve(model, multipliers.as_deref(), true) {
         Ok((z, lambda)) => {
             *multipliers = Some(lambda);
             z
