@@ -28,6 +28,11 @@ const TOLERANCE: f64 = 1e-10;
 const MAX_ITERATIONS: usize = 80;
 /// Most refinement steps of one Newton solve.
 const REFINEMENT_STEPS: usize = 30;
+/// The backward error at which refinement stops: each block's residual
+/// relative to the size of its terms. The interior point asks its residuals
+/// for [`FEASIBILITY`]; a direction this accurate leaves them unchanged to
+/// a hundredth of that.
+const REFINED: f64 = 1e-10;
 /// Refinement steps of the predictor, which only sets the centring.
 const PREDICTOR_REFINEMENT: usize = 0;
 /// A program that lowers the model by `Δ` is solved once its gap is below
@@ -84,7 +89,7 @@ pub(super) fn solve(
         .collect();
     let mut lambda = match warm {
         Some(w) if w.len() == n_rows => w.iter().map(|&l| l.max(WARM_FLOOR)).collect(),
-        _ => vec![1.0; n_rows],
+        _ => rows.cold_multipliers(),
     };
     let mut y = vec![0.0; n_eq];
     let c_norm = norm_inf(&model.gradient(&vec![0.0; n])).max(1.0);
@@ -196,9 +201,12 @@ fn refined_solve(
     max_steps: usize,
 ) -> (Vec<f64>, Vec<f64>) {
     let (mut dz, mut dy) = kkt.solve(bz, by);
-    // Each block's residual relative to its own right-hand side: the
-    // equilibrium's is tiny near the optimum and would hide in a joint norm.
-    let (bz_norm, by_norm) = (norm_inf(bz).max(1e-300), norm_inf(by).max(1e-300));
+    // Each block's residual relative to the size of its own terms (a
+    // backward error): the equilibrium's right-hand side is tiny near the
+    // optimum (zero at the start), so its residual is measured against
+    // `‖E‖ ‖δz‖`, and would hide in a joint norm.
+    let (bz_norm, by_norm) = (norm_inf(bz), norm_inf(by));
+    let e_norm = model.equilibrium_norm();
     let mut previous = f64::INFINITY;
     for _ in 0..max_steps {
         // r = b − K (δz, δy).
@@ -210,8 +218,10 @@ fn refined_solve(
         model.equilibrium_mul(&dz, &mut ky);
         let rz: Vec<f64> = bz.iter().zip(&kz).map(|(b, k)| b - k).collect();
         let ry: Vec<f64> = by.iter().zip(&ky).map(|(b, k)| b - k).collect();
-        let norm = (norm_inf(&rz) / bz_norm).max(norm_inf(&ry) / by_norm);
-        if norm <= 1e-15 || norm > 0.5 * previous {
+        let z_size = bz_norm.max(norm_inf(&kz)).max(f64::MIN_POSITIVE);
+        let y_size = by_norm.max(e_norm * norm_inf(&dz)).max(f64::MIN_POSITIVE);
+        let norm = (norm_inf(&rz) / z_size).max(norm_inf(&ry) / y_size);
+        if norm <= REFINED || norm > 0.5 * previous {
             break;
         }
         previous = norm;
@@ -279,6 +289,26 @@ impl<'a> Rows<'a> {
                 i += 2;
             }
         }
+    }
+
+    /// The first multipliers of a cold start: the rows of each set, and the
+    /// box's, each sum to the ratio weight `w`, so that the dual rows of the
+    /// bounds `u_g`, `l_g` (gradient `±w`, balanced by their set's `λ`) start
+    /// balanced. All ones leaves them off by the set's size: on a
+    /// 10⁴-node net 14 iterations against 11.
+    fn cold_multipliers(&self) -> Vec<f64> {
+        let model = self.model;
+        let w = if model.weight > 0.0 {
+            model.weight
+        } else {
+            1.0
+        };
+        let m = model.m();
+        let mut lambda = vec![w / m as f64; 2 * m];
+        for set in &model.sets {
+            lambda.extend(std::iter::repeat_n(w / set.len() as f64, 2 * set.len()));
+        }
+        lambda
     }
 
     /// The weights `λ/s` in the form `kkt.rs` takes.

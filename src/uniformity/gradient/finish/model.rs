@@ -226,6 +226,21 @@ impl StepModel {
         }
     }
 
+    /// `‖E‖∞`, the largest absolute row sum of the linearised equilibrium.
+    pub(super) fn equilibrium_norm(&self) -> f64 {
+        let mut sums = vec![0.0; 3 * self.n_free];
+        for cable in &self.cables {
+            let free = cable.ends.iter().filter(|&&f| f != NONE);
+            let per_row = |d: usize| cable.q * (cable.u[d].abs() + free.clone().count() as f64);
+            for &f in free.clone() {
+                for d in 0..3 {
+                    sums[3 * f + d] += self.row_scale[f] * per_row(d);
+                }
+            }
+        }
+        sums.into_iter().fold(0.0, f64::max)
+    }
+
     /// `out += Eᵀ y`.
     pub(super) fn equilibrium_transpose_mul(&self, y: &[f64], out: &mut [f64]) {
         let at_xi = self.at_xi();
