@@ -137,18 +137,18 @@ pub(super) fn solve(
             rows.add_transpose_mul(&shifted, &mut gts);
             bz.iter_mut().zip(&gts).for_each(|(b, g)| *b -= g);
             let by: Vec<f64> = r_eq.iter().map(|v| -v).collect();
-            let (dz, dy) = refined_solve(model, &rows, &d, &mut kkt, &bz, &by, refinement);
+            let (dz, dy) = refined_solve(model, &rows, &d, &mut kkt, &bz, &by, refinement)?;
             let gdz = rows.mul(&dz);
             let ds: Vec<f64> = (0..n_rows).map(|i| -r_rows[i] - gdz[i]).collect();
             let dl: Vec<f64> = (0..n_rows)
                 .map(|i| (-r_c[i] - lambda[i] * ds[i]) / s[i])
                 .collect();
-            (dz, dy, ds, dl)
+            Ok::<_, String>((dz, dy, ds, dl))
         };
 
         // Predictor.
         let r_c: Vec<f64> = s.iter().zip(&lambda).map(|(s, l)| s * l).collect();
-        let (_, _, ds, dl) = direction(&r_c, PREDICTOR_REFINEMENT);
+        let (_, _, ds, dl) = direction(&r_c, PREDICTOR_REFINEMENT)?;
         let alpha = step_to_boundary(&s, &ds).min(step_to_boundary(&lambda, &dl));
         let gap_affine: f64 = (0..n_rows)
             .map(|i| (s[i] + alpha * ds[i]) * (lambda[i] + alpha * dl[i]))
@@ -159,7 +159,7 @@ pub(super) fn solve(
         let r_c: Vec<f64> = (0..n_rows)
             .map(|i| s[i] * lambda[i] + ds[i] * dl[i] - sigma * mu)
             .collect();
-        let (dz, dy, ds, dl) = direction(&r_c, REFINEMENT_STEPS);
+        let (dz, dy, ds, dl) = direction(&r_c, REFINEMENT_STEPS)?;
         let alpha = (STEP_FRACTION * step_to_boundary(&s, &ds).min(step_to_boundary(&lambda, &dl)))
             .min(1.0);
         for (v, d) in z.iter_mut().zip(&dz) {
@@ -199,8 +199,8 @@ fn refined_solve(
     bz: &[f64],
     by: &[f64],
     max_steps: usize,
-) -> (Vec<f64>, Vec<f64>) {
-    let (mut dz, mut dy) = kkt.solve(bz, by);
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let (mut dz, mut dy) = kkt.solve(bz, by).map_err(|e| e.0)?;
     // Each block's residual relative to the size of its own terms (a
     // backward error): the equilibrium's right-hand side is tiny near the
     // optimum (zero at the start), so its residual is measured against
@@ -225,11 +225,11 @@ fn refined_solve(
             break;
         }
         previous = norm;
-        let (cz, cy) = kkt.solve(&rz, &ry);
+        let (cz, cy) = kkt.solve(&rz, &ry).map_err(|e| e.0)?;
         dz.iter_mut().zip(&cz).for_each(|(v, c)| *v += c);
         dy.iter_mut().zip(&cy).for_each(|(v, c)| *v += c);
     }
-    (dz, dy)
+    Ok((dz, dy))
 }
 
 /// The inequality rows `G z ≤ h`: per cable the box's upper and lower row,

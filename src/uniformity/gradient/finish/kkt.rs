@@ -19,9 +19,14 @@
 //! blocks, `R = [Hξξ − Hξp h⁻¹ Hpξ, ·; E_ξ − E_p h⁻¹ Hpξ, −E_p h⁻¹ E_pᵀ]`, factored
 //! by faer's sparse LDLᵀ (pattern and ordering: `block_pattern.rs`;
 //! dynamic regularisation with the signs `+` on `ξ`, `−` on `y`); the border
-//! is eliminated with `nb` more solves and an `nb × nb` dense system. The
-//! `ξξ` part of one cable is `D_k d_k/h_k g gᵀ` — the difference
-//! `D_k − D_k²/h_k` formed without cancellation.
+//! is eliminated through its `nb × nb` Schur complement, factored densely
+//! with pivoting (its `nb` columns are solved with the first right-hand
+//! side after each factorisation, one solve with `nb + 1` columns). Put in
+//! the sparse factor as its last rows, the border is lost near the optimum:
+//! the level of all tensions (`u_g + l_g`) is fixed only by the box and the
+//! level term, and its pivot is then below the dynamic regularisation's
+//! threshold. The `ξξ` part of one cable is `D_k d_k/h_k g gᵀ` — the
+//! difference `D_k − D_k²/h_k` formed without cancellation.
 //!
 //! Near the optimum `h_k` of a cable whose rows are all inactive tends to
 //! zero, and eliminating `p_k` through it would amplify rounding by
@@ -84,9 +89,11 @@ pub(super) struct Kkt<'a> {
     /// `h_k` and `D_k` of the current iteration.
     h: Vec<f64>,
     ratio: Vec<f64>,
-    /// The border's columns over `(p, ξ, y)`, `M0⁻¹` of them, and the
-    /// factored `C − BᵀM0⁻¹B`.
+    /// The border's columns `B` over `(p, ξ, y)` and its corner `C`, `M0⁻¹B`,
+    /// and the factored `C − BᵀM0⁻¹B` (`None` until the first solve after a
+    /// factorisation).
     border: Vec<Vec<f64>>,
+    corner: Vec<f64>,
     border_solved: Vec<Vec<f64>>,
     schur: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
 }
@@ -105,7 +112,7 @@ impl<'a> Kkt<'a> {
         } = BlockPattern::new(&ends, n_free, B).map_err(|e| KktError(e.to_string()))?;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_ldlt_scratch::<f64>(PAR, Default::default()),
-            symbolic.solve_in_place_scratch::<f64>(2 * model.sets.len() + 1, PAR),
+            symbolic.solve_in_place_scratch::<f64>(2 * model.sets.len() + 2, PAR),
         ]);
         let buffer = MemBuffer::try_new(req)
             .map_err(|_| KktError("out of memory for the factorisation".into()))?;
@@ -126,6 +133,7 @@ impl<'a> Kkt<'a> {
             h: vec![0.0; m],
             ratio: vec![0.0; m],
             border: Vec::new(),
+            corner: Vec::new(),
             border_solved: Vec::new(),
             schur: None,
         })
@@ -179,19 +187,35 @@ impl<'a> Kkt<'a> {
             border.push(column);
             corner.push(-0.5 / model.level_weight);
         }
-        let mut solved: Vec<f64> = border.concat();
-        self.solve_sparse(&mut solved);
-        let solved: Vec<Vec<f64>> = solved.chunks(n_sparse).map(<[f64]>::to_vec).collect();
-        let nb = border.len();
+        self.border = border;
+        self.corner = corner;
+        self.schur = None;
+        Ok(())
+    }
+
+    /// Solves with `M0` the border's columns together with `w` (one solve
+    /// with several columns costs less than two), and factors the border's
+    /// Schur complement `C − BᵀM0⁻¹B`.
+    fn solve_with_border(&mut self, w: &mut Vec<f64>) -> Result<(), KktError> {
+        let n_sparse = self.n_sparse();
+        let mut columns: Vec<f64> = self.border.concat();
+        columns.extend_from_slice(w);
+        self.solve_sparse(&mut columns);
+        *w = columns.split_off(self.border.len() * n_sparse);
+        let solved: Vec<Vec<f64>> = columns.chunks(n_sparse).map(<[f64]>::to_vec).collect();
+        let nb = self.border.len();
         let schur = DMatrix::from_fn(nb, nb, |i, j| {
-            let product: f64 = border[i].iter().zip(&solved[j]).map(|(a, b)| a * b).sum();
+            let product: f64 = self.border[i]
+                .iter()
+                .zip(&solved[j])
+                .map(|(a, b)| a * b)
+                .sum();
             if i == j {
-                corner[i] - product
+                self.corner[i] - product
             } else {
                 -product
             }
         });
-        self.border = border;
         self.border_solved = solved;
         let schur = schur.lu();
         if !schur.is_invertible() {
@@ -400,12 +424,21 @@ impl<'a> Kkt<'a> {
     }
 
     /// Solves the Newton system for the right-hand side `(rz, ry)` with the
-    /// current factor: returns `(δz, δy)`.
-    pub(super) fn solve(&mut self, rz: &[f64], ry: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    /// current factor: returns `(δz, δy)`. The first solve after a
+    /// factorisation also solves for the border.
+    pub(super) fn solve(
+        &mut self,
+        rz: &[f64],
+        ry: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), KktError> {
         let model = self.model;
         let (m, at_bounds) = (model.m(), model.at_bounds());
         let mut w: Vec<f64> = rz[..at_bounds].iter().chain(ry).copied().collect();
-        self.solve_sparse(&mut w);
+        if self.schur.is_none() {
+            self.solve_with_border(&mut w)?;
+        } else {
+            self.solve_sparse(&mut w);
+        }
         let n_bounds = rz.len() - at_bounds;
         let nb = self.border.len();
         let rhs = DVector::from_fn(nb, |i, _| {
@@ -421,7 +454,7 @@ impl<'a> Kkt<'a> {
             .schur
             .as_ref()
             .and_then(|lu| lu.solve(&rhs))
-            .unwrap_or_else(|| DVector::zeros(nb));
+            .ok_or_else(|| KktError("the border's Schur complement is singular".into()))?;
         for (column, &tj) in self.border_solved.iter().zip(t.iter()) {
             for (wi, ci) in w.iter_mut().zip(column) {
                 *wi -= ci * tj;
@@ -430,6 +463,6 @@ impl<'a> Kkt<'a> {
         let y = w.split_off(at_bounds);
         debug_assert_eq!(w.len(), m + 3 * model.n_free);
         w.extend(t.iter().take(n_bounds));
-        (w, y)
+        Ok((w, y))
     }
 }
