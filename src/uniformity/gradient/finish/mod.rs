@@ -35,9 +35,9 @@
 //! the nonsmooth problem that does not depend on the net's size.
 //!
 //! The program is solved by an interior point on its structure (`ipm.rs`,
-//! with the Newton systems reduced to the node graph in `kkt.rs`): 10–14
-//! iterations of one sparse LDLᵀ of `6 n_free` unknowns each cold, 5–8 warm
-//! from the previous step's multipliers — 5–8× faster than clarabel on the
+//! with the Newton systems reduced to the node graph in `kkt.rs`): 7–11
+//! iterations of one sparse LDLᵀ of `6 n_free` unknowns each cold, 5–7 warm
+//! from the previous step's multipliers — 7–13× faster than clarabel on the
 //! program stated generically. clarabel remains the fallback, and the
 //! cross-check of the tests. Either solver's point is made feasible before
 //! its value is read ([`StepModel::feasible_point`]).

@@ -230,11 +230,13 @@ impl StepModel {
     pub(super) fn equilibrium_norm(&self) -> f64 {
         let mut sums = vec![0.0; 3 * self.n_free];
         for cable in &self.cables {
-            let free = cable.ends.iter().filter(|&&f| f != NONE);
-            let per_row = |d: usize| cable.q * (cable.u[d].abs() + free.clone().count() as f64);
-            for &f in free.clone() {
+            // A row's entries: `q u_d` on p_k, `q` on ξ_d of each free end.
+            let free_ends = cable.ends.iter().filter(|&&f| f != NONE);
+            let n_free_ends = free_ends.clone().count() as f64;
+            for &f in free_ends {
                 for d in 0..3 {
-                    sums[3 * f + d] += self.row_scale[f] * per_row(d);
+                    sums[3 * f + d] +=
+                        self.row_scale[f] * cable.q * (cable.u[d].abs() + n_free_ends);
                 }
             }
         }
