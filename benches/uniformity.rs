@@ -28,7 +28,7 @@
 //! * `gradient_exact` — `gradient-exact` (the exact finish: sequential QPs on
 //!   the unsmoothed ratio) on the 428- and 2 516-node tied nets, printed as
 //!   above (`RINGMESH_BENCH_EXACT_RINGS=26,41` adds 4 208 and 10 328 nodes,
-//!   ≈ 2.5 s and 10 s a solve).
+//!   ≈ 2.5 s and 9 s a solve).
 //!
 //! Run with `cargo bench --bench uniformity`.
 
