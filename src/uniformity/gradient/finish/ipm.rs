@@ -219,7 +219,7 @@ fn refined_solve(
     // right-hand side is tiny near the optimum (zero at the start): it is
     // measured against `‖E‖ ‖δz‖` where that is larger.
     let (bz_norm, by_norm) = (norm_inf(bz), norm_inf(by));
-    let e_norm = model.equilibrium_norm();
+    let e_norm = kkt.equilibrium_norm;
     let mut previous = f64::INFINITY;
     for _ in 0..max_steps {
         // r = b − K (δz, δy).

@@ -96,6 +96,9 @@ pub(super) struct Kkt<'a> {
     corner: Vec<f64>,
     border_solved: Vec<Vec<f64>>,
     schur: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// `‖E‖∞` of the model, the scale of the equilibrium's residual in
+    /// refinement (once per program, not per solve).
+    pub(super) equilibrium_norm: f64,
 }
 
 impl<'a> Kkt<'a> {
@@ -136,6 +139,7 @@ impl<'a> Kkt<'a> {
             corner: Vec::new(),
             border_solved: Vec::new(),
             schur: None,
+            equilibrium_norm: model.equilibrium_norm(),
         })
     }
 
