@@ -17,18 +17,24 @@
 //!   (20–40 s a solve);
 //! * `gradient_nodes` — the `gradient` solver on the paper scene with 3 rings
 //!   (362 net nodes);
-//! * `gradient_independent` — the `gradient` solver on the independently
-//!   generated tied nets of `lp_independent`'s `hex5` kind, 428 and 4 208
-//!   nodes (`RINGMESH_BENCH_GRADIENT_RINGS=41,130` adds ≈ 10⁴ and 10⁵); the
-//!   ratio against `lp`'s, the surface RMS and the iterations of one solve
+//! * `gradient_independent` — the `gradient` solver (L-BFGS from afar, then
+//!   the exact finish: sequential QPs on the unsmoothed ratio; here from
+//!   `lp`'s optimum, without L-BFGS) on the independently generated tied
+//!   nets of `lp_independent`'s `hex5` kind, 428 and 2 516 nodes
+//!   (`RINGMESH_BENCH_GRADIENT_RINGS=26,41,130` adds 4 208, 10 328 and
+//!   102 176: ≈ 2.5 s, 9 s and minutes a solve); the ratio against `lp`'s,
+//!   the surface RMS, the iterations and the exact objective of one solve
 //!   are printed beside the time;
-//! * `gradient_sharpness` — the `gradient` solver on the 2 516-node tied net
-//!   (20 rings) at the soft max's sharpness 100, 300 and 1 000: what a sharper
-//!   ratio surrogate costs (printed as above);
-//! * `gradient_exact` — `gradient-exact` (the exact finish: sequential QPs on
-//!   the unsmoothed ratio) on the 428- and 2 516-node tied nets, printed as
-//!   above (`RINGMESH_BENCH_EXACT_RINGS=26,41` adds 4 208 and 10 328 nodes,
-//!   ≈ 2.5 s and 9 s a solve).
+//! * `smooth_independent` — `gradient-smooth` (L-BFGS on the soft max/min
+//!   alone) on the same nets, 428 and 4 208 nodes
+//!   (`RINGMESH_BENCH_SMOOTH_RINGS=41,130` adds ≈ 10⁴ and 10⁵), printed as
+//!   above;
+//! * `smooth_sharpness` — `gradient-smooth` on the 2 516-node tied net
+//!   (20 rings) at the soft max's sharpness 100, 300 and 1 000: what a
+//!   sharper ratio surrogate costs (printed as above).
+//!
+//! A net of more than [`SAMPLED_MAX_NODES`] nodes is solved once, its time
+//! printed, not sampled: criterion's ten samples would take an hour.
 //!
 //! Run with `cargo bench --bench uniformity`.
 
@@ -80,6 +86,7 @@ fn solvers(c: &mut Criterion) {
         SolverKind::Lp,
         SolverKind::Bisection,
         SolverKind::Gradient,
+        SolverKind::GradientSmooth,
         SolverKind::LeastSquares,
     ] {
         let solver = kind.build(None);
@@ -171,27 +178,53 @@ fn gradient_nodes(c: &mut Criterion) {
     group.finish();
 }
 
-/// Rings of the independently generated nets of `gradient_independent`:
-/// 428 and 4 208 nodes by default (issue 17's ~430-node net and the next
-/// decade); `RINGMESH_BENCH_GRADIENT_RINGS=41,130` adds ≈ 10⁴ and 10⁵.
-fn gradient_independent(c: &mut Criterion) {
-    let rings = with_extra(vec![8, 26], "RINGMESH_BENCH_GRADIENT_RINGS");
-    let mut group = c.benchmark_group("gradient_independent");
+/// Nets above this many nodes are solved once, not sampled.
+const SAMPLED_MAX_NODES: usize = 50_000;
+
+/// `solver` on the independently generated tied nets of `rings` rings and
+/// of the rings in the environment variable `var`.
+fn independent(c: &mut Criterion, name: &str, solver: &Gradient, rings: Vec<usize>, var: &str) {
+    let mut group = c.benchmark_group(name);
     group.sample_size(10);
-    for r in rings {
+    for r in with_extra(rings, var) {
         let net = hexnet::HexNet::like_hex5(r);
         let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
         let nodes = p.network().n_nodes();
-        print_gradient_solve(
-            &format!("gradient_independent/{nodes}"),
-            &Gradient::default(),
-            &p,
-        );
-        group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
-            b.iter(|| Gradient::default().solve(p))
-        });
+        print_gradient_solve(&format!("{name}/{nodes}"), solver, &p);
+        if nodes <= SAMPLED_MAX_NODES {
+            group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
+                b.iter(|| solver.solve(p))
+            });
+        }
     }
     group.finish();
+}
+
+/// `gradient` on the tied nets: 428 nodes (issue 17's ~430-node net) and
+/// 2 516.
+fn gradient_independent(c: &mut Criterion) {
+    let solver = Gradient::default();
+    let rings = vec![8, 20];
+    independent(
+        c,
+        "gradient_independent",
+        &solver,
+        rings,
+        "RINGMESH_BENCH_GRADIENT_RINGS",
+    );
+}
+
+/// `gradient-smooth` on the tied nets: 428 and 4 208 nodes.
+fn smooth_independent(c: &mut Criterion) {
+    let solver = Gradient::smooth();
+    let rings = vec![8, 26];
+    independent(
+        c,
+        "smooth_independent",
+        &solver,
+        rings,
+        "RINGMESH_BENCH_SMOOTH_RINGS",
+    );
 }
 
 /// What one `solver` solve of `p` reaches, printed beside the benchmark's time:
@@ -215,39 +248,19 @@ fn print_gradient_solve(id: &str, solver: &Gradient, p: &UniformityProblem) {
     }
 }
 
-/// The exact finish against the smoothed solve on the tied nets.
-fn gradient_exact(c: &mut Criterion) {
-    let mut group = c.benchmark_group("gradient_exact");
-    group.sample_size(10);
-    for r in with_extra(vec![8, 20], "RINGMESH_BENCH_EXACT_RINGS") {
-        let net = hexnet::HexNet::like_hex5(r);
-        let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
-        let nodes = p.network().n_nodes();
-        let solver = Gradient {
-            exact_finish: true,
-            ..Gradient::default()
-        };
-        print_gradient_solve(&format!("gradient_exact/{nodes}"), &solver, &p);
-        group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
-            b.iter(|| solver.solve(p))
-        });
-    }
-    group.finish();
-}
-
 /// The sharpness of the soft max/min against time and iterations on a net
 /// where the default (1 000) needs thousands of L-BFGS iterations.
-fn gradient_sharpness(c: &mut Criterion) {
+fn smooth_sharpness(c: &mut Criterion) {
     let net = hexnet::HexNet::like_hex5(20);
     let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
-    let mut group = c.benchmark_group("gradient_sharpness");
+    let mut group = c.benchmark_group("smooth_sharpness");
     group.sample_size(10);
     for sharpness in [100.0, 300.0, 1000.0] {
         let solver = Gradient {
             sharpness,
-            ..Gradient::default()
+            ..Gradient::smooth()
         };
-        print_gradient_solve(&format!("gradient_sharpness/{sharpness}"), &solver, &p);
+        print_gradient_solve(&format!("smooth_sharpness/{sharpness}"), &solver, &p);
         group.bench_with_input(BenchmarkId::from_parameter(sharpness), &p, |b, p| {
             b.iter(|| solver.solve(p))
         });
@@ -263,7 +276,7 @@ criterion_group!(
     lp_independent,
     gradient_nodes,
     gradient_independent,
-    gradient_sharpness,
-    gradient_exact
+    smooth_independent,
+    smooth_sharpness
 );
 criterion_main!(benches);

@@ -189,7 +189,7 @@ fn gradient_matches_central_differences_with_prescribed_target() {
 #[test]
 fn gradient_descends_to_a_stationary_point() {
     let problem = common::front_problem(&common::scene("small-hex"));
-    let solver = Gradient::default();
+    let solver = Gradient::smooth();
     let (design, history) = solver.solve_with_history(&problem).unwrap();
     assert_eq!(
         design.termination,
@@ -252,12 +252,18 @@ fn assert_near_lp_optimum(name: &str) {
     let scene = common::scene(name);
     let problem = common::front_problem(&scene);
     let lp = Lp.solve(&problem).unwrap();
-    let design = Gradient::default().solve(&problem).unwrap();
-    assert_converged_near(name, &design, lp.ratio, 1.05);
-    let q_max = scene.cables.max_force_density_n_per_m;
-    assert!(design.q.iter().all(|&q| q > 0.0 && q <= q_max));
-    let mean = &design.sets[0].mean_tension_n;
-    assert!((mean / scene.front_net.mean_tension_n - 1.0).abs() < 1e-3);
+    for solver in [Gradient::default(), Gradient::smooth()] {
+        let design = solver.solve(&problem).unwrap();
+        let case = format!("{name}, {}", solver.name());
+        assert_converged_near(&case, &design, lp.ratio, 1.05);
+        let q_max = scene.cables.max_force_density_n_per_m;
+        assert!(design.q.iter().all(|&q| q > 0.0 && q <= q_max), "{case}");
+        let mean = &design.sets[0].mean_tension_n;
+        assert!(
+            (mean / scene.front_net.mean_tension_n - 1.0).abs() < 1e-3,
+            "{case}"
+        );
+    }
 }
 
 #[test]
@@ -273,20 +279,26 @@ fn gradient_reaches_lp_optimum_on_offset_scene() {
 #[test]
 fn weight_trades_surface_error_for_uniformity() {
     let problem = common::front_problem(&common::scene("small-hex"));
-    let designs: Vec<_> = [1.0, 1e2, 1e4]
-        .iter()
-        .map(|&weight| {
-            Gradient {
-                weight,
-                ..Gradient::default()
-            }
-            .solve(&problem)
-            .unwrap()
-        })
-        .collect();
-    for pair in designs.windows(2) {
-        assert!(pair[1].surface_rms_m > pair[0].surface_rms_m);
-        assert!(pair[1].ratio < pair[0].ratio);
+    for solver in [Gradient::default(), Gradient::smooth()] {
+        let designs: Vec<_> = [1.0, 1e2, 1e4]
+            .iter()
+            .map(|&weight| {
+                Gradient {
+                    weight,
+                    ..solver.clone()
+                }
+                .solve(&problem)
+                .unwrap()
+            })
+            .collect();
+        for pair in designs.windows(2) {
+            assert!(
+                pair[1].surface_rms_m > pair[0].surface_rms_m,
+                "{}",
+                solver.name()
+            );
+            assert!(pair[1].ratio < pair[0].ratio, "{}", solver.name());
+        }
     }
 }
 
@@ -331,24 +343,27 @@ fn geometry_held_reaches_the_lp_optimum() {
         let lp = Lp.solve(&problem).unwrap();
         // From the projected uniform-tension guess, not from `lp`'s
         // optimum: the descent itself must get there.
-        let design = Gradient {
-            weight: 1e-2,
-            optimum_start: false,
-            ..Gradient::default()
+        for solver in [Gradient::default(), Gradient::smooth()] {
+            let design = Gradient {
+                weight: 1e-2,
+                optimum_start: false,
+                ..solver.clone()
+            }
+            .solve(&problem)
+            .unwrap();
+            let case = format!("{}, {}", scene.name, solver.name());
+            assert_converged_near(&case, &design, lp.ratio, 1.01);
         }
-        .solve(&problem)
-        .unwrap();
-        assert_converged_near(&scene.name, &design, lp.ratio, 1.01);
     }
 }
 
-/// `design --solver gradient`'s loop (and `gradient-exact`'s) converges to
+/// `design --solver gradient`'s loop (and `gradient-smooth`'s) converges to
 /// 1e-6 m on small-hex and paper-26m: each design starts from the last boundary's, so its `q`
 /// moves smoothly with the boundary (issue 17: it stalled at 1e-5 m on
 /// paper-26m before).
 #[test]
 fn the_design_loop_converges_with_the_gradient_solver() {
-    for kind in [SolverKind::Gradient, SolverKind::GradientExact] {
+    for kind in [SolverKind::Gradient, SolverKind::GradientSmooth] {
         let solver = kind.build(None);
         for name in ["small-hex", "paper-26m"] {
             let scene = common::scene(name);
@@ -373,7 +388,7 @@ fn the_design_loop_converges_with_the_gradient_solver() {
     }
 }
 
-/// The gradient fronts on small-hex (smoothed and exact) are monotone: as
+/// The gradient fronts on small-hex (exact and smoothed) are monotone: as
 /// the ratio's weight grows (the surface's loosens) the ratio never rises,
 /// each point started from its neighbour's design.
 #[test]
@@ -381,7 +396,7 @@ fn the_gradient_front_is_monotone() {
     let problem = common::front_problem(&common::scene("small-hex"));
     let front = design_front(
         &problem,
-        &[SolverKind::Gradient, SolverKind::GradientExact],
+        &[SolverKind::Gradient, SolverKind::GradientSmooth],
         10,
         &|_| {},
     );
@@ -436,13 +451,10 @@ fn finish_problems() -> Vec<(String, UniformityProblem)> {
 #[test]
 fn exact_finish_lands_on_the_true_minimum() {
     for (name, problem) in finish_problems() {
-        let exact = Gradient {
-            exact_finish: true,
-            ..Gradient::default()
-        };
+        let exact = Gradient::default();
         let lp = Lp.solve(&problem).unwrap();
         let j_lp = exact.exact_objective(&problem, &lp.q).unwrap();
-        let smoothed = Gradient::default().solve(&problem).unwrap();
+        let smoothed = Gradient::smooth().solve(&problem).unwrap();
         let j_smoothed = exact.exact_objective(&problem, &smoothed.q).unwrap();
         let starts = [
             ("lp", exact.clone()),
@@ -514,7 +526,6 @@ fn exact_finish_with_the_geometry_held_is_the_lp_optimum() {
             weight: 1e-2,
             optimum_start: false,
             max_iterations: 0,
-            exact_finish: true,
             ..Gradient::default()
         }
         .solve(&problem)

@@ -172,12 +172,8 @@ fn boundary_node_on_a_straight_chord_is_reported_infeasible_by_name() {
     mesh.network.nodes[rear][1] = y;
     let problem =
         UniformityProblem::from_mesh(&mesh, &[(CableGroup::Front, 70.0)], 5000.0).unwrap();
-    let gradient = Gradient::default();
-    let exact = Gradient {
-        exact_finish: true,
-        ..Gradient::default()
-    };
-    let solvers: [&dyn UniformitySolver; 4] = [&Lp, &Bisection::default(), &gradient, &exact];
+    let (exact, smooth) = (Gradient::default(), Gradient::smooth());
+    let solvers: [&dyn UniformitySolver; 4] = [&Lp, &Bisection::default(), &exact, &smooth];
     for solver in solvers {
         // Infeasibility is a design's termination; a caller that needs a
         // design gets it as the error naming the nodes.

@@ -160,7 +160,8 @@ pub struct Design {
     pub surface_max_m: f64,
     /// How the solver stopped.
     pub termination: Termination,
-    /// Iterations of the solver (bisection steps, L-BFGS iterations, …).
+    /// Iterations of the solver (bisection steps, L-BFGS iterations plus
+    /// the exact finish's programs, …).
     pub iterations: usize,
     /// Wall time of the solve, s.
     pub time_s: f64,

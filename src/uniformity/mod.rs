@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | [`Lp`] | one LP `min s`, `1 ≤ T_k ≤ s`, `A q = 0`, rescaled (homogeneous, one set) | — |
 //! | [`Bisection`] | ratio bisection of LP feasibility, or SOCP with `‖A q − p‖ ≤ ε` | ε |
-//! | [`Gradient`] | free geometry, adjoint gradient, L-BFGS | weight of the ratio term |
+//! | [`Gradient`] | free geometry, adjoint gradient, L-BFGS, then sequential QPs on the exact ratio (`gradient-smooth`: L-BFGS alone) | weight of the ratio term |
 //! | [`LeastSquares`] | `min ‖L q − T̄‖²` s.t. `A q = p`, or Tikhonov `λ` | λ |
 
 mod bisection;
@@ -184,11 +184,12 @@ pub enum SolverKind {
     Bisection,
     /// One LP (clarabel): the homogeneous single-set baseline.
     Lp,
-    /// Free-geometry adjoint L-BFGS (argmin).
+    /// Free geometry: adjoint L-BFGS (argmin) from a far start, finished by
+    /// sequential quadratic programs on the unsmoothed `ln(Tmax/Tmin)` — the
+    /// true minimiser for the weight.
     Gradient,
-    /// `gradient` with its exact finish: sequential QPs (clarabel) on the
-    /// unsmoothed `ln(Tmax/Tmin)`, the true minimiser for the weight.
-    GradientExact,
+    /// `gradient` without its finish: L-BFGS on the soft max/min alone.
+    GradientSmooth,
     /// Constrained or Tikhonov least squares (faer).
     LeastSquares,
 }
@@ -211,7 +212,7 @@ impl SolverKind {
     /// ([`UniformitySolver::solve_from`]); the others solve every problem
     /// afresh.
     pub fn warm_starts(self) -> bool {
-        matches!(self, SolverKind::Gradient | SolverKind::GradientExact)
+        matches!(self, SolverKind::Gradient | SolverKind::GradientSmooth)
     }
 
     /// The solver with its default settings, or with its accuracy knob set.
@@ -222,9 +223,9 @@ impl SolverKind {
                 ..Bisection::default()
             }),
             SolverKind::Lp => Box::new(Lp),
-            SolverKind::Gradient | SolverKind::GradientExact => {
+            SolverKind::Gradient | SolverKind::GradientSmooth => {
                 let defaults = Gradient {
-                    exact_finish: self == SolverKind::GradientExact,
+                    exact_finish: self == SolverKind::Gradient,
                     ..Gradient::default()
                 };
                 Box::new(Gradient {

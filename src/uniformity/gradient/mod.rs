@@ -1,6 +1,7 @@
 //! Free-geometry gradient solver (DESIGN §4): forward FDM from `q` with no
 //! prescribed positions, a smooth penalty objective, its adjoint gradient
-//! (DESIGN §3), and argmin's L-BFGS with a More–Thuente line search.
+//! (DESIGN §3), and argmin's L-BFGS with a More–Thuente line search,
+//! finished on the exact, nonsmooth objective (see *Exact finish*).
 //!
 //! # Objective
 //!
@@ -107,14 +108,15 @@
 //! tension for the spread of the next ones (on the benches' tied nets its
 //! `J` is 6e-5 … 4e-3 above the true minimum), and L-BFGS pays for a
 //! sharper surrogate in iterations, about in proportion to `β`, following
-//! the cables at the extremes. With [`Gradient::exact_finish`] (the solver
-//! `gradient-exact`) the solve ends with sequential quadratic programs on
-//! the objective with the exact `ln(Tmax/Tmin)` ([`finish`]): 2–4 programs
-//! from `lp`'s optimum or a neighbour's design, whatever the size, to a
-//! stationarity certificate of the nonsmooth problem. L-BFGS then runs only
-//! from a far start (the uniform-tension guess), to bring it near. Each
-//! program is solved by an interior point on the net's structure (one
-//! sparse LDLᵀ of the node graph in 6×6 blocks an iteration).
+//! the cables at the extremes. With [`Gradient::exact_finish`] (the
+//! default; the solver `gradient-smooth` goes without) the solve ends with
+//! sequential quadratic programs on the objective with the exact
+//! `ln(Tmax/Tmin)` ([`finish`]): 2–4 programs from `lp`'s optimum or a
+//! neighbour's design, whatever the size, to a stationarity certificate of
+//! the nonsmooth problem. L-BFGS then runs only from a far start (the
+//! uniform-tension guess), to bring it near. Each program is solved by an
+//! interior point on the net's structure (one sparse LDLᵀ of the node graph
+//! in 6×6 blocks an iteration).
 
 mod finish;
 mod lbfgs;
@@ -180,12 +182,13 @@ pub struct Gradient {
     /// Start from the fixed-geometry optimum (`lp`'s design) where `lp`
     /// applies (one set, no loads), before any other start.
     pub optimum_start: bool,
-    /// After L-BFGS, sequential quadratic programs (clarabel) on the exact
-    /// objective, `ln(Tmax/Tmin)` in place of its soft form, to its
-    /// stationarity (see [`finish`]): the true minimiser for the weight, in
-    /// a few programs whatever the size, each far dearer than an L-BFGS
-    /// iteration. From a start near the optimum (`lp`'s, a neighbour's) or
-    /// with `max_iterations = 0` the programs start there, without L-BFGS.
+    /// After L-BFGS, sequential quadratic programs on the exact objective,
+    /// `ln(Tmax/Tmin)` in place of its soft form, to its stationarity (see
+    /// [`finish`]): the true minimiser for the weight, in a few programs
+    /// whatever the size, each far dearer than an L-BFGS iteration. From a
+    /// start near the optimum (`lp`'s, a neighbour's) or with
+    /// `max_iterations = 0` the programs start there, without L-BFGS. On by
+    /// default; off, the solver `gradient-smooth` ([`Gradient::smooth`]).
     pub exact_finish: bool,
 }
 
@@ -207,12 +210,21 @@ impl Default for Gradient {
             precondition: true,
             project_start: true,
             optimum_start: true,
-            exact_finish: false,
+            exact_finish: true,
         }
     }
 }
 
 impl Gradient {
+    /// The smoothed solve alone (the solver `gradient-smooth`): L-BFGS on the
+    /// soft max/min, without the exact finish.
+    pub fn smooth() -> Self {
+        Gradient {
+            exact_finish: false,
+            ..Gradient::default()
+        }
+    }
+
     /// Checks the settings.
     pub fn validate(&self) -> Result<(), UniformityError> {
         let bad = |name: &'static str, value: f64, range: &'static str| {
@@ -534,9 +546,9 @@ pub struct History {
 impl UniformitySolver for Gradient {
     fn name(&self) -> &'static str {
         if self.exact_finish {
-            "gradient-exact"
-        } else {
             "gradient"
+        } else {
+            "gradient-smooth"
         }
     }
 
