@@ -447,7 +447,9 @@ fn finish_problems() -> Vec<(String, UniformityProblem)> {
 /// solve's end point, and the uniform-tension guess without L-BFGS — it
 /// ends at one exact `J` to 1e-8, below both `lp`'s design's and the
 /// smoothed solve's (whose soft max trades the largest tension for the
-/// spread of the next ones), in at most ten quadratic programs.
+/// spread of the next ones), in at most 12 quadratic programs (2–5 from
+/// `lp`'s optimum and the smoothed end point, 11 from the guess: its first
+/// five run to the trust radius).
 #[test]
 fn exact_finish_lands_on_the_true_minimum() {
     for (name, problem) in finish_problems() {
@@ -488,7 +490,7 @@ fn exact_finish_lands_on_the_true_minimum() {
                 design.warnings
             );
             assert!(
-                (1..=10).contains(&history.finish_steps),
+                (1..=12).contains(&history.finish_steps),
                 "{name} from {start}: {} steps",
                 history.finish_steps
             );

@@ -193,6 +193,33 @@ pub(super) fn solve(
     ))
 }
 
+/// Adds to `model` the curvature its linearised `δ ln T_k = p_k + …` leaves
+/// out, weighted by the multipliers `lambda` of the previous step's rows
+/// (the Lagrangian's Hessian of sequential quadratic programming): `ln(1 +
+/// p) = p − p²/2`, so the lower row of cable `k` curves by `+λ_low` and
+/// the upper by `−λ_high`; the sum, where positive (the program stays
+/// convex). Without it the model is linear along the sets' extremes, its
+/// step ends at the trust radius, and the concave `ln` costs the lowest
+/// tensions `≈ p²/2` that no step sees.
+pub(super) fn add_log_curvature(model: &mut StepModel, lambda: &[f64]) {
+    let m = model.m();
+    let set_rows: usize = model.sets.iter().map(|set| 2 * set.len()).sum();
+    if lambda.len() != 2 * m + set_rows {
+        return;
+    }
+    let mut curvature = vec![0.0; m];
+    let mut i = 2 * m;
+    for set in &model.sets {
+        for &(k, _) in set {
+            curvature[k] += lambda[i + 1] - lambda[i];
+            i += 2;
+        }
+    }
+    for (cable, c) in model.cables.iter_mut().zip(curvature) {
+        cable.curvature = c.max(0.0);
+    }
+}
+
 /// The largest `α ≤ 1/STEP_FRACTION` with `v + α dv ≥ 0`.
 fn step_to_boundary(v: &[f64], dv: &[f64]) -> f64 {
     v.iter()

@@ -23,6 +23,9 @@ pub(super) struct Cable {
     /// The box `lo ≤ p_k ≤ hi` (the barrier's box within the trust region).
     pub(super) lo: f64,
     pub(super) hi: f64,
+    /// The model's curvature `c_k` in `p_k`, a term `½ c_k p_k²` (see
+    /// `ipm::add_log_curvature`).
+    pub(super) curvature: f64,
 }
 
 /// One surface error `ē = e + gradient·ξ_node` (Gauss–Newton).
@@ -152,7 +155,14 @@ impl StepModel {
         let level = self.level + self.level_change(z);
         let bounds = &z[self.at_bounds()..];
         let ratios: f64 = bounds.chunks(2).map(|b| b[0] - b[1]).sum();
-        self.error_weight * errors
+        let curvature: f64 = self
+            .cables
+            .iter()
+            .zip(z)
+            .map(|(cable, p)| cable.curvature * p * p)
+            .sum();
+        0.5 * curvature
+            + self.error_weight * errors
             + self.drift_weight * drifts
             + self.level_weight * level * level
             + self.weight * ratios
@@ -180,6 +190,9 @@ impl StepModel {
     fn quadratic_terms(&self, z: &[f64], constants: f64) -> Vec<f64> {
         let at_xi = self.at_xi();
         let mut out = vec![0.0; self.n()];
+        for ((o, cable), p) in out.iter_mut().zip(&self.cables).zip(z) {
+            *o = cable.curvature * p;
+        }
         for row in &self.errors {
             if row.node == NONE {
                 continue;
@@ -382,6 +395,7 @@ impl StepModel {
         }
         // lo ≤ p_k ≤ hi.
         for (k, cable) in self.cables.iter().enumerate() {
+            p[k] = cable.curvature;
             program.row(Cone::Nonnegative, &[(k, -1.0)], -cable.lo);
             program.row(Cone::Nonnegative, &[(k, 1.0)], cable.hi);
         }
