@@ -22,7 +22,8 @@
 //!
 //! the linearised equilibrium, `ē = e + ∇e·δx`, `v` the linearised change of
 //! `ln T̄₀`, the box `f t₀/ℓ̂_k ≤ q_k + δq_k ≤ 0.99 [q]` (the barrier's) and the
-//! trust region `|δq_k| ≤ r q_k`. The max/min enter exactly, as the bounds
+//! trust region `|δq_k| ≤ r q_k` (`−min(4r, 0.9) q_k ≤ δq_k` for a cable
+//! outside the sets). The max/min enter exactly, as the bounds
 //! `u_g`, `l_g` of every cable of the set: the step sees which cables are at
 //! the extremes, as `lp` does, and the geometry's reply to `δq` at once.
 //! `p_k = δq_k/q_k`, and `c_k` is the curvature the linearisation leaves
@@ -33,7 +34,8 @@
 //! every other step ran to the trust radius, lost `≈ p²/2` on the lowest
 //! tensions and was rejected (26 programs, J still 2e-3 above the end);
 //! with it the model predicts each decrease to 1 % and no step is refused
-//! (15 programs to the certificate; 4 on 10⁴ nodes, as before).
+//! (15 programs to the certificate, 6 with the reach of
+//! [`OUTSIDE_REACH`]; 4 on 10⁴ nodes, as before).
 //!
 //! The step is taken on `q` alone (the geometry follows by a forward solve)
 //! when `J_exact` falls by more than a tenth of the decrease the model
@@ -95,11 +97,17 @@ pub(super) const MAX_FINISH_STEPS: usize = 50;
 /// The first trust radius, relative change of `q`.
 const FIRST_RADIUS: f64 = 0.05;
 /// The largest trust radius (`q` stays above half its value at a step).
-/// Cables outside the sets that the optimum slackens (ties of the tied
-/// nets) halve at most a step: 15 programs on the 38 876-node net, the
-/// last nine of them spent so. At 0.9 it took 11, but 19 from the
-/// uniform-tension guess on the 428-node net (against 11).
+/// At 0.9 the 428-node net took 19 programs from the uniform-tension guess
+/// (against 11).
 const MAX_RADIUS: f64 = 0.5;
+/// A cable outside the sets may fall by this many times the trust radius
+/// a step, to at most [`MAX_FALL`]: the optimum slackens some (the ties of
+/// the tied nets), the model follows them well (they carry no ratio term),
+/// and halving them at most a step took the 38 876-node net 15 programs,
+/// the last nine spent so; with this reach, 6.
+const OUTSIDE_REACH: f64 = 4.0;
+/// The largest fall of a cable outside the sets in one step, relative.
+const MAX_FALL: f64 = 0.9;
 /// Below this radius a rejected step ends the finish.
 const MIN_RADIUS: f64 = 1e-9;
 
@@ -196,6 +204,12 @@ fn step_model(
     let free = |i: usize| structure.free_index(i).unwrap_or(NONE);
     let n_free = structure.free_nodes().len();
     let mut row_sum = vec![0.0; n_free];
+    let mut in_set = vec![false; q.len()];
+    for set in problem.sets() {
+        for &k in &set.edges {
+            in_set[k] = true;
+        }
+    }
     let cables: Vec<Cable> = structure
         .edges()
         .iter()
@@ -210,7 +224,12 @@ fn step_model(
             let u = eq.edges_vectors_m[k];
             let l2 = eq.edges_lengths_m[k].powi(2);
             let reach = radius * q[k];
-            let lo = (objective.q_low[k] - q[k]).clamp(-reach, reach);
+            let fall = if in_set[k] {
+                reach
+            } else {
+                (OUTSIDE_REACH * radius).min(MAX_FALL) * q[k]
+            };
+            let lo = (objective.q_low[k] - q[k]).clamp(-fall, reach);
             let hi = (objective.q_high - q[k]).clamp(lo, reach);
             Cable {
                 ends,
