@@ -11,7 +11,7 @@ for scene in small-hex realistic-26m paper-26m; do
 done
 "$ringmesh" design problems/super-60m.toml
 "$ringmesh" mesh problems/paper-26m.toml
-"$ringmesh" front problems/paper-26m.toml --solvers bisection,gradient,gradient-exact,least-squares
+"$ringmesh" front problems/paper-26m.toml --solvers bisection,gradient,gradient-smooth,least-squares
 "$ringmesh" study problems/paper-26m.toml
 "$ringmesh" study problems/realistic-26m.toml
 # The tube of paper-26m sized for a margin of 2, from the shipped catalogue

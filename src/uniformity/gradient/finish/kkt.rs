@@ -6,7 +6,8 @@
 //!
 //! * `p` (one per cable): the box rows and the set rows of cable `k` give
 //!   the diagonal `h_k = d_k + D_k` (`d_k` the box's weight and the
-//!   model's curvature `c_k`, `D_k` the set rows'), and couple `p_k` to `ξ` of its ends through `φ_k = ∂δs_k/∂z`;
+//!   model's curvature `c_k`, `D_k` the set rows'), and couple `p_k` to `ξ`
+//!   of its ends through `φ_k = ∂δs_k/∂z`;
 //! * `ξ` and `y` (three each per free node): the surface terms and `D_k φ_k
 //!   φ_kᵀ` on `ξ`, the linearised equilibrium `E` between them;
 //! * a border of a few dense columns: the bounds `u_g`, `l_g` of each set
@@ -158,8 +159,8 @@ impl<'a> Kkt<'a> {
                 self.ratio[k] += d.high[g][i] + d.low[g][i];
             }
         }
-        // h_k = D_k + rest_k, the rest the box's weight, raised to keep h_k
-        // at least P_FLOOR.
+        // h_k = D_k + rest_k, the rest the box's weight and the curvature,
+        // raised to keep h_k at least P_FLOOR.
         let rest: Vec<f64> = (0..m)
             .map(|k| (d.boxes[k] + model.cables[k].curvature).max(P_FLOOR - self.ratio[k]))
             .collect();
