@@ -181,50 +181,40 @@ fn gradient_nodes(c: &mut Criterion) {
 /// Nets above this many nodes are solved once, not sampled.
 const SAMPLED_MAX_NODES: usize = 50_000;
 
-/// `solver` on the independently generated tied nets of `rings` rings and
-/// of the rings in the environment variable `var`.
-fn independent(c: &mut Criterion, name: &str, solver: &Gradient, rings: Vec<usize>, var: &str) {
-    let mut group = c.benchmark_group(name);
-    group.sample_size(10);
-    for r in with_extra(rings, var) {
-        let net = hexnet::HexNet::like_hex5(r);
-        let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
-        let nodes = p.network().n_nodes();
-        print_gradient_solve(&format!("{name}/{nodes}"), solver, &p);
-        if nodes <= SAMPLED_MAX_NODES {
-            group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
-                b.iter(|| solver.solve(p))
-            });
+/// The gradient solvers on the independently generated tied nets:
+/// `gradient` on 428 (issue 17's ~430-node net) and 2 516 nodes,
+/// `gradient-smooth` on 428 and 4 208, each with the rings of its
+/// environment variable.
+fn independent(c: &mut Criterion) {
+    for (name, solver, rings, var) in [
+        (
+            "gradient_independent",
+            Gradient::default(),
+            vec![8, 20],
+            "RINGMESH_BENCH_GRADIENT_RINGS",
+        ),
+        (
+            "smooth_independent",
+            Gradient::smooth(),
+            vec![8, 26],
+            "RINGMESH_BENCH_SMOOTH_RINGS",
+        ),
+    ] {
+        let mut group = c.benchmark_group(name);
+        group.sample_size(10);
+        for r in with_extra(rings, var) {
+            let net = hexnet::HexNet::like_hex5(r);
+            let p = hexnet::tied_net_problem(net.build(), "hangers", 50.0, 1e9);
+            let nodes = p.network().n_nodes();
+            print_gradient_solve(&format!("{name}/{nodes}"), &solver, &p);
+            if nodes <= SAMPLED_MAX_NODES {
+                group.bench_with_input(BenchmarkId::from_parameter(nodes), &p, |b, p| {
+                    b.iter(|| solver.solve(p))
+                });
+            }
         }
+        group.finish();
     }
-    group.finish();
-}
-
-/// `gradient` on the tied nets: 428 nodes (issue 17's ~430-node net) and
-/// 2 516.
-fn gradient_independent(c: &mut Criterion) {
-    let solver = Gradient::default();
-    let rings = vec![8, 20];
-    independent(
-        c,
-        "gradient_independent",
-        &solver,
-        rings,
-        "RINGMESH_BENCH_GRADIENT_RINGS",
-    );
-}
-
-/// `gradient-smooth` on the tied nets: 428 and 4 208 nodes.
-fn smooth_independent(c: &mut Criterion) {
-    let solver = Gradient::smooth();
-    let rings = vec![8, 26];
-    independent(
-        c,
-        "smooth_independent",
-        &solver,
-        rings,
-        "RINGMESH_BENCH_SMOOTH_RINGS",
-    );
 }
 
 /// What one `solver` solve of `p` reaches, printed beside the benchmark's time:
@@ -275,8 +265,7 @@ criterion_group!(
     lp_nodes,
     lp_independent,
     gradient_nodes,
-    gradient_independent,
-    smooth_independent,
+    independent,
     smooth_sharpness
 );
 criterion_main!(benches);
