@@ -102,6 +102,16 @@ pub enum Error {
     Memory(#[from] resources::MemoryError),
 }
 
+impl From<truss::SceneResponseError> for Error {
+    fn from(e: truss::SceneResponseError) -> Self {
+        match e {
+            truss::SceneResponseError::Scene(e) => Error::Scene(e),
+            truss::SceneResponseError::Net(e) => Error::Fdm(e),
+            truss::SceneResponseError::Truss(e) => Error::Truss(e),
+        }
+    }
+}
+
 impl Error {
     /// True when the error is the user's input (exit code 2), false for I/O and
     /// internal failures (exit code 1).
@@ -117,10 +127,7 @@ impl Error {
             Error::Study(e) => e.is_bad_input(),
             Error::Shard(e) => e.is_bad_input(),
             Error::Sizing(e) => e.is_bad_input(),
-            Error::Verify(e) => matches!(
-                e,
-                verify::VerifyError::Mechanics(mechanics::MechanicsError::Invalid { .. })
-            ),
+            Error::Verify(e) => e.is_bad_input(),
         }
     }
 }

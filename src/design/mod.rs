@@ -43,8 +43,10 @@ pub use relaxation::{
 pub use scene_nets::{default_solver, scene_problem, SceneNets};
 pub use tied_nets::{TiedDesign, TiedNets};
 
+use crate::scene::SceneError;
 use crate::truss::TrussError;
 use crate::uniformity::{Termination, UniformityError};
+use crate::verify::VerifyError;
 
 /// The outer loop cannot go on.
 #[derive(Debug, thiserror::Error)]
@@ -85,6 +87,19 @@ pub enum DesignError {
         #[source]
         source: TrussError,
     },
+    /// The scene's nets cannot be built.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The design problem cannot be stated (bounds, loads, groups).
+    #[error(transparent)]
+    Problem(#[from] UniformityError),
+    /// The ring truss cannot be built, or the design's pull is past its limit
+    /// load ([`TrussError::PastLimitLoad`]).
+    #[error(transparent)]
+    RingTruss(#[from] TrussError),
+    /// The design cannot be assembled as built.
+    #[error(transparent)]
+    Verify(#[from] VerifyError),
 }
 
 impl DesignError {
@@ -94,7 +109,12 @@ impl DesignError {
             DesignError::Setting { .. } => true,
             DesignError::Uniformity { source, .. } => source.is_bad_input(),
             DesignError::NoDesign { termination, .. } => *termination == Termination::Infeasible,
-            DesignError::Truss { source, .. } => source.is_bad_input(),
+            DesignError::Truss { source, .. } | DesignError::RingTruss(source) => {
+                source.is_bad_input()
+            }
+            DesignError::Scene(_) => true,
+            DesignError::Problem(e) => e.is_bad_input(),
+            DesignError::Verify(e) => e.is_bad_input(),
         }
     }
 }

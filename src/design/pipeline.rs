@@ -13,15 +13,13 @@ use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings, LoopTerminat
 use super::relaxation::RelaxationKind;
 use super::scene_nets::{default_solver, SceneNets};
 use super::DesignError;
-use crate::effects::SceneEffects;
 use crate::geometry::ReflectorMesh;
 use crate::mechanics::LimitSearch;
 use crate::network::Network;
 use crate::scene::{Scene, TrussModel};
-use crate::truss::{RingTruss, TrussError};
+use crate::truss::{RingTruss, RingTrussBuilder, TrussError};
 use crate::uniformity::{Design, SolverKind, UniformitySet};
-use crate::verify::{verify, AssemblyTruss, Verification};
-use crate::Error;
+use crate::verify::{verify_on_frame, Verification};
 
 /// Choices of a design run: plain data with defaults.
 #[derive(Debug, Clone)]
@@ -215,7 +213,7 @@ pub fn run(
     scene: &Scene,
     settings: &DesignSettings,
     observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
-) -> Result<DesignRun, Error> {
+) -> Result<DesignRun, DesignError> {
     let clock = Instant::now();
     let mut timings = Timings::default();
     let model = settings.truss.unwrap_or(scene.effects.truss);
@@ -280,15 +278,15 @@ pub fn run(
             // No truss equilibrium: say how far below the pull the truss's
             // stability ends (the rigid-truss design's pull, the loop's first).
             Err(
-                e @ Error::Design(DesignError::Truss {
+                e @ DesignError::Truss {
                     source: TrussError::NoEquilibrium { .. },
                     ..
-                }),
+                },
             ) => {
                 let first =
                     nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
                 return Err(
-                    match design_margin(scene, mesh, &scene_nets.effects, &first.design) {
+                    match design_margin(scene_nets.truss_frame(scene), &first.design) {
                         Err(past) => past,
                         Ok(_) => e,
                     },
@@ -299,47 +297,43 @@ pub fn run(
     }
     let outcome = outcome.expect("at least one relaxation");
     let effects = &scene_nets.effects;
-    let assembly = if outcome.truss_deforms {
-        AssemblyTruss::Flexible
-    } else {
-        AssemblyTruss::Rigid
-    };
+    // The flexible truss's frame, constructed once for the loop's oracle,
+    // the margin and both assemblies.
+    let frame = outcome.truss_deforms.then(|| scene_nets.truss_frame(scene));
     let stage = Instant::now();
-    let limit_margin = match assembly {
-        AssemblyTruss::Rigid => None,
-        AssemblyTruss::Flexible => Some(design_margin(scene, mesh, effects, &outcome.design)?),
+    let limit_margin = match frame {
+        None => None,
+        Some(frame) => Some(design_margin(frame, &outcome.design)?),
     };
     timings.margin_s = stage.elapsed().as_secs_f64();
     let stage = Instant::now();
     let network = outcome.problem.network().clone();
     let sets = outcome.problem.sets().to_vec();
-    let verification = verify(
+    let verification = verify_on_frame(
         scene,
         mesh,
         effects,
         &network,
         &outcome.design,
-        assembly,
+        frame,
         outcome.truss_equilibrium.as_ref(),
     )?;
     timings.verification_s = stage.elapsed().as_secs_f64();
     let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
-    // undeformed attachment points.
-    let conventional_net = match assembly {
-        AssemblyTruss::Rigid => None,
-        AssemblyTruss::Flexible => Some(outcome.initial.design.clone()),
-    };
-    let conventional = match assembly {
-        AssemblyTruss::Rigid => None,
-        AssemblyTruss::Flexible => Some(verify(
+    // undeformed attachment points, assembled from the truss's response to
+    // it that the loop already solved.
+    let conventional_net = frame.map(|_| outcome.initial.design.clone());
+    let conventional = match frame {
+        None => None,
+        Some(frame) => Some(verify_on_frame(
             scene,
             mesh,
             effects,
             outcome.initial.problem.network(),
             &outcome.initial.design,
-            AssemblyTruss::Flexible,
-            None,
+            Some(frame),
+            outcome.initial_truss_equilibrium.as_ref(),
         )?),
     };
     timings.conventional_s = stage.elapsed().as_secs_f64();
@@ -372,21 +366,19 @@ pub fn run(
     })
 }
 
-/// The margin of `scene`'s truss (with `effects`) to its limit load under
-/// `design`'s pull.
+/// The margin of the ring truss of `frame` ([`SceneNets::truss_frame`]) to
+/// its limit load under `design`'s pull.
 ///
 /// # Errors
 /// A truss that cannot be built, or a pull it cannot carry stably
 /// ([`TrussError::PastLimitLoad`]).
 pub fn design_margin(
-    scene: &Scene,
-    mesh: &ReflectorMesh,
-    effects: &SceneEffects,
+    frame: &RingTrussBuilder,
     design: &Design,
-) -> Result<LimitSearch, Error> {
+) -> Result<LimitSearch, DesignError> {
     // The net pulls on its supports with −F_g.
     let pull = design.pull_n();
-    let truss = RingTruss::new(scene, &mesh.truss, effects).map_err(TrussError::from)?;
+    let truss = RingTruss::from_frame(frame.clone()).map_err(TrussError::from)?;
     let margin = crate::truss::limit_margin(truss, &pull)?;
     if margin.stable_to < 1.0 {
         return Err(TrussError::PastLimitLoad {

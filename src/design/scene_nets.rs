@@ -2,13 +2,16 @@
 //! uniformity problem for the theoretical boundary, and the two-stage design
 //! problem built on it, with the loads of the effects the scene asks for.
 
+use std::sync::OnceLock;
+
 use super::outer_loop::{design_loop, IterationRecord, LoopOutcome, LoopSettings};
 use super::tied_nets::TiedNets;
+use super::DesignError;
 use crate::effects::SceneEffects;
 use crate::geometry::{build_mesh, ReflectorMesh};
 use crate::scene::{Scene, TrussModel};
+use crate::truss::{oracle_on_frame, RingTruss, RingTrussBuilder};
 use crate::uniformity::{SolverKind, UniformityProblem, UniformitySolver};
-use crate::Error;
 
 /// The uniformity problem of a scene's front net for its theoretical boundary,
 /// under the nodal loads of the effects the scene asks for (the cables' self
@@ -16,7 +19,7 @@ use crate::Error;
 ///
 /// # Errors
 /// A mesh or uniformity problem that cannot be built.
-pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem), Error> {
+pub fn scene_problem(scene: &Scene) -> Result<(ReflectorMesh, UniformityProblem), DesignError> {
     problem_with(scene, &SceneEffects::of(scene))
 }
 
@@ -33,7 +36,7 @@ pub fn default_solver(scene: &Scene) -> SolverKind {
 fn problem_with(
     scene: &Scene,
     effects: &SceneEffects,
-) -> Result<(ReflectorMesh, UniformityProblem), Error> {
+) -> Result<(ReflectorMesh, UniformityProblem), DesignError> {
     let mesh = build_mesh(scene)?;
     let mut problem = UniformityProblem::from_mesh(
         &mesh,
@@ -54,6 +57,9 @@ pub struct SceneNets {
     pub nets: TiedNets,
     /// The effects the scene asks for, built once for every stage.
     pub effects: SceneEffects,
+    /// The ring truss's frame, constructed the first time a stage needs it
+    /// ([`SceneNets::truss_frame`]) and copied to each stage after.
+    frame: OnceLock<RingTrussBuilder>,
 }
 
 impl SceneNets {
@@ -61,7 +67,7 @@ impl SceneNets {
     ///
     /// # Errors
     /// An invalid mesh or uniformity problem.
-    pub fn new(scene: &Scene) -> Result<SceneNets, Error> {
+    pub fn new(scene: &Scene) -> Result<SceneNets, DesignError> {
         SceneNets::with_effects(scene, SceneEffects::of(scene))
     }
 
@@ -70,13 +76,14 @@ impl SceneNets {
     ///
     /// # Errors
     /// An invalid mesh or uniformity problem.
-    pub fn with_effects(scene: &Scene, effects: SceneEffects) -> Result<SceneNets, Error> {
+    pub fn with_effects(scene: &Scene, effects: SceneEffects) -> Result<SceneNets, DesignError> {
         let (mesh, problem) = problem_with(scene, &effects)?;
         let nets = TiedNets::new(&mesh, problem)?.with_effects(&effects);
         Ok(SceneNets {
             mesh,
             nets,
             effects,
+            frame: OnceLock::new(),
         })
     }
 
@@ -93,14 +100,17 @@ impl SceneNets {
         model: TrussModel,
         settings: &LoopSettings,
         observe: &mut dyn FnMut(&IterationRecord),
-    ) -> Result<LoopOutcome, Error> {
-        let mut oracle = crate::truss::oracle(model, scene, &self.mesh.truss, &self.effects)?;
-        Ok(design_loop(
-            &self.nets,
-            solver,
-            oracle.as_mut(),
-            settings,
-            observe,
-        )?)
+    ) -> Result<LoopOutcome, DesignError> {
+        let mut oracle =
+            oracle_on_frame(model, &self.mesh.truss, || self.truss_frame(scene).clone())?;
+        design_loop(&self.nets, solver, oracle.as_mut(), settings, observe)
+    }
+
+    /// The frame of `scene`'s ring truss on this mesh's layout, with the
+    /// scene's effects: constructed once (the first call), for the loop's
+    /// oracle, the limit margin and every assembly.
+    pub fn truss_frame(&self, scene: &Scene) -> &RingTrussBuilder {
+        self.frame
+            .get_or_init(|| RingTruss::builder(scene, &self.mesh.truss, &self.effects))
     }
 }

@@ -10,7 +10,7 @@ use crate::sizing::SectionTrial;
 use crate::study::{value_name, ApertureResult, Knob, RunSettings, StudyRow};
 use crate::uniformity::{Design, FrontPoint, SolverKind};
 
-use super::{decimal, readable};
+use super::number::{decimal, readable};
 
 /// `id,group,i,j,q,tension_n,length_m,cut_length_m`: one row per cable, with the
 /// unstressed cut length `L0 = ℓ/(1 + T/EA)` (DESIGN §7).

@@ -13,8 +13,8 @@
 //! What is left behind by a run killed with SIGKILL is a staging folder
 //! beside the target (`.NAME.staging-RUN`), never a file in it; the next
 //! run into the same folder removes it. SIGINT and SIGTERM remove it at once
-//! ([`abandon_all_and_exit`], which the CLI's signal handler calls), with every
-//! temporary file [`super::write_atomic`] has open.
+//! ([`super::abandon_all_and_exit`], which the CLI's signal handler calls), with every
+//! temporary file [`super::write_atomic`] has open (`pending.rs`).
 //!
 //! The lock is an advisory `flock` on the target folder itself, so it leaves
 //! no file behind; a run that locked a folder which another run has just
@@ -23,87 +23,26 @@
 use std::fs::{self, File};
 use std::io;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use rustix::fs::FlockOperation;
+use serde::Serialize;
 
-use super::ReportError;
-
-/// Staging folders and temporary files of this process, removed by
-/// [`abandon_all_and_exit`]; also held while a set is swapped in.
-static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+use super::atomic::write_atomic;
+use super::error::ReportError;
+use super::pending::{lock_pending, unregister};
 
 /// Longest file name most file systems take, bytes.
 const NAME_MAX: usize = 255;
 
-/// Creates the temporary file `path` (and its folder, if missing),
-/// registered for removal on interruption. Registry, folder and file are
-/// made under the registry's lock: a signal handler, which holds that lock
-/// until the process exits, either finds them all and removes them, or
-/// none is created — a folder made after its removal would outlive the run.
-pub(super) fn create_registered(path: &Path) -> io::Result<File> {
-    let mut pending = lock_pending();
-    pending.push(path.to_path_buf());
-    let created = (|| {
-        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-            fs::create_dir_all(parent)?;
-        }
-        File::create(path)
-    })();
-    if created.is_err() {
-        pending.retain(|p| p != path);
-    }
-    created
-}
-
-/// Forgets `path` (written, renamed or removed).
-pub(super) fn unregister(path: &Path) {
-    lock_pending().retain(|p| p != path);
-}
-
-fn lock_pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
-    PENDING.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// Removes every staging folder and temporary file this process has open
-/// and exits with `code`: for a signal handler. Waits for a set being
-/// swapped in to finish, and holds the registry until the exit, so that no
-/// new file or folder is created ([`create_registered`]); a write already
-/// under way may still rename or link a file into a folder being removed,
-/// so each removal is retried until it holds.
-pub fn abandon_all_and_exit(code: i32) -> ! {
-    let pending = lock_pending();
-    for path in pending.iter() {
-        for _ in 0..200 {
-            let _ = if path.is_dir() {
-                fs::remove_dir_all(path)
-            } else {
-                fs::remove_file(path)
-            };
-            if fs::symlink_metadata(path).is_err() {
-                break;
-            }
-            std::thread::sleep(std::time::Duration::from_millis(1));
-        }
-    }
-    std::process::exit(code)
-}
-
-/// Where a file staged at `path` goes: `path` itself unless it lies in a
-/// staging folder `.NAME.staging-RUN`, then the same name in `NAME` (what a
-/// message about the file should name).
-pub(super) fn shown(path: &Path) -> PathBuf {
-    let staged = || {
-        let dir = path.parent()?;
-        let (folder, _) = dir
-            .file_name()?
-            .to_str()?
-            .strip_prefix('.')?
-            .split_once(".staging-")?;
-        Some(dir.parent()?.join(folder).join(path.file_name()?))
-    };
-    staged().unwrap_or_else(|| path.to_path_buf())
+/// A run's JSON report with its [`RunRecord`] first (`"run": {…}`).
+#[derive(Serialize)]
+pub struct WithRun<'a, T: Serialize> {
+    /// The run's identifier and files.
+    pub run: &'a RunRecord,
+    /// The report.
+    #[serde(flatten)]
+    pub report: &'a T,
 }
 
 /// A new run's identifier: time and process, unique on one machine.
@@ -212,7 +151,7 @@ impl OutputSet {
         fs::create_dir_all(dir).map_err(unwritable_at(dir))?;
         let _lock = lock_folder(dir, Wait::Yes)?;
         let path = dir.join(name);
-        super::write_atomic(&path, bytes)?;
+        write_atomic(&path, bytes)?;
         Ok(path)
     }
 
@@ -267,7 +206,7 @@ impl OutputSet {
             };
             let bytes = match stamped {
                 Some(stamped) => {
-                    super::write_atomic(&path, &stamped)?;
+                    write_atomic(&path, &stamped)?;
                     stamped
                 }
                 None => bytes,
@@ -627,15 +566,6 @@ mod tests {
         check_manifest(&dir, &record).unwrap();
         fs::write(dir.join("a.csv"), "x,y\n1,2\n").unwrap();
         assert!(check_manifest(&dir, &record).unwrap_err().contains("a.csv"));
-    }
-
-    #[test]
-    fn messages_name_the_target_not_the_staging_folder() {
-        assert_eq!(
-            shown(Path::new("/r/.small-hex.staging-17-5-3/cables.csv")),
-            Path::new("/r/small-hex/cables.csv")
-        );
-        assert_eq!(shown(Path::new("/r/out/a.csv")), Path::new("/r/out/a.csv"));
     }
 
     #[test]

@@ -7,7 +7,9 @@ use std::sync::Once;
 
 use plotters::prelude::*;
 
-use super::{write_atomic, DrawError, FrontRow, ReportError};
+use super::atomic::write_atomic;
+use super::csv::FrontRow;
+use super::error::{DrawError, ReportError};
 use crate::scene::TrussModel;
 use crate::study::{pareto_optimal, ApertureResult, Knob, StudyRow};
 

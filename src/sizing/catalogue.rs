@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::SizingError;
+use super::error::SizingError;
 use crate::scene::Truss;
 
 /// One round tube: the section every rod of the ring truss is made of.

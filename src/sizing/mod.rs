@@ -26,13 +26,16 @@
 //!   3 % of `M`.
 
 pub mod catalogue;
+mod error;
 
 use std::time::Instant;
 
 use serde::Serialize;
 
 pub use catalogue::TubeSection;
+pub use error::SizingError;
 
+use crate::design::DesignError;
 use crate::design::{DesignRun, DesignSettings, LoopTermination};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::LimitBound;
@@ -40,64 +43,6 @@ use crate::mechanics::LimitBound;
 use crate::mechanics::LimitSearch;
 use crate::scene::{Scene, TrussModel};
 use crate::truss::{TrussError, MARGIN_SEARCH_TO as SEARCH_TO};
-use crate::Error;
-
-/// A sizing that cannot run, or finds nothing.
-#[derive(Debug, thiserror::Error)]
-pub enum SizingError {
-    /// An invalid margin.
-    #[error(
-        "sizing: margin {value} must be at least 1 and at most {max} (the limit search's end)"
-    )]
-    Margin {
-        /// The margin asked for.
-        value: f64,
-        /// The largest margin the limit search certifies.
-        max: f64,
-    },
-    /// A bad catalogue.
-    #[error("{path}{}: {reason}", line.map(|l| format!(", line {l}")).unwrap_or_default())]
-    Catalogue {
-        /// The file.
-        path: String,
-        /// The line at fault, from 1.
-        line: Option<usize>,
-        /// What is wrong.
-        reason: String,
-    },
-    /// A scene whose truss cannot be sized.
-    #[error("sizing: `{key}`: {reason}")]
-    Scene {
-        /// The scene key at fault.
-        key: &'static str,
-        /// Why.
-        reason: String,
-    },
-    /// No section carries the net with the margin.
-    #[error(
-        "no section carries the net with a margin of {margin}: the stiffest tried ({outer_mm:.1}/{inner_mm:.1} mm) reaches {best:.3}{}",
-        detail.as_ref().map(|d| format!(" ({d})")).unwrap_or_default()
-    )]
-    NoSection {
-        /// The margin asked for.
-        margin: f64,
-        /// The stiffest section tried, its outer and inner diameter, mm.
-        outer_mm: f64,
-        /// Its inner diameter, mm.
-        inner_mm: f64,
-        /// Its margin.
-        best: f64,
-        /// Why its design failed, if it did.
-        detail: Option<String>,
-    },
-}
-
-impl SizingError {
-    /// True when the error is the user's input (exit code 2).
-    pub fn is_bad_input(&self) -> bool {
-        !matches!(self, SizingError::NoSection { .. })
-    }
-}
 
 /// Where the sections come from.
 #[derive(Debug, Clone)]
@@ -181,28 +126,25 @@ pub fn size_truss(
     margin: f64,
     settings: &DesignSettings,
     observe: &mut dyn FnMut(&SectionTrial),
-) -> Result<Sizing, Error> {
+) -> Result<Sizing, SizingError> {
     if !((1.0..=SEARCH_TO).contains(&margin)) {
         return Err(SizingError::Margin {
             value: margin,
             max: SEARCH_TO,
-        }
-        .into());
+        });
     }
     if scene.effects.rod_properties_csv.is_some() {
         return Err(SizingError::Scene {
             key: "effects.rod_properties_csv",
             reason: "the rods are measured one by one; sizing sets the nominal tube of every rod"
                 .into(),
-        }
-        .into());
+        });
     }
     if settings.truss.unwrap_or(scene.effects.truss) != TrussModel::Exact {
         return Err(SizingError::Scene {
             key: "effects.truss",
             reason: "sizing needs the exact truss: only it has a limit load".into(),
-        }
-        .into());
+        });
     }
     let mut search = Search {
         scene,
@@ -232,8 +174,7 @@ pub fn size_truss(
             inner_mm: 1e3 * stiffest.section.inner_diameter_m,
             best: stiffest.margin,
             detail: stiffest.failure.clone(),
-        }
-        .into());
+        });
     };
     let mut sized = scene.clone();
     sized.truss = search.trials[chosen].section.apply(&scene.truss);
@@ -259,7 +200,7 @@ struct Search<'a> {
 
 impl Search<'_> {
     /// Designs on `section`: whether it carries.
-    fn try_section(&mut self, section: TubeSection) -> Result<bool, Error> {
+    fn try_section(&mut self, section: TubeSection) -> Result<bool, SizingError> {
         let mut scene = self.scene.clone();
         scene.truss = section.apply(&self.scene.truss);
         scene.validate()?;
@@ -303,7 +244,7 @@ impl Search<'_> {
                 }
                 Some(TrussError::NoEquilibrium { .. }) => trial.failure = Some(e.to_string()),
                 // Not the tube's doing: no section would design.
-                _ => return Err(e),
+                _ => return Err(e.into()),
             },
         }
         (self.observe)(&trial);
@@ -323,7 +264,7 @@ impl Search<'_> {
     }
 
     /// Bisection on `sections` (lightest first): the first that carries.
-    fn catalogue(&mut self, sections: &[TubeSection]) -> Result<(), Error> {
+    fn catalogue(&mut self, sections: &[TubeSection]) -> Result<(), SizingError> {
         let (mut lo, mut hi) = (0, sections.len());
         while lo < hi {
             let mid = (lo + hi) / 2;
@@ -337,7 +278,7 @@ impl Search<'_> {
     }
 
     /// The outer diameter at the scene's `d/D`, from `start_m`.
-    fn continuous(&mut self, start_m: f64) -> Result<(), Error> {
+    fn continuous(&mut self, start_m: f64) -> Result<(), SizingError> {
         let base = TubeSection::of(&self.scene.truss);
         let ratio = base.inner_diameter_m / base.outer_diameter_m;
         let section = |outer: f64| TubeSection {
@@ -405,10 +346,9 @@ impl Search<'_> {
 }
 
 /// The truss's failure inside `e`, if it is one.
-fn truss_failure(e: &Error) -> Option<&TrussError> {
+fn truss_failure(e: &DesignError) -> Option<&TrussError> {
     match e {
-        Error::Truss(t) => Some(t),
-        Error::Design(crate::design::DesignError::Truss { source, .. }) => Some(source),
+        DesignError::RingTruss(t) | DesignError::Truss { source: t, .. } => Some(t),
         _ => None,
     }
 }

@@ -34,7 +34,6 @@ use crate::scene::{membrane_tension_n, Scene, TrussModel};
 use crate::sizing::{size_truss, Sections, SizingError, TubeSection};
 use crate::uniformity::Design;
 use crate::verify::Verification;
-use crate::Error;
 
 /// Largest aperture a study may ask for, m.
 pub const MAX_APERTURE_M: f64 = 1_000.0;
@@ -46,20 +45,18 @@ pub const MAX_APERTURE_M: f64 = 1_000.0;
 /// An aperture that is not a finite number in `(0, MAX_APERTURE_M]`, a
 /// scene whose rods are measured one by one, or a scaled scene that is
 /// invalid (its error names the key).
-pub fn scaled(scene: &Scene, aperture_m: f64) -> Result<Scene, Error> {
+pub fn scaled(scene: &Scene, aperture_m: f64) -> Result<Scene, SizingError> {
     if !(aperture_m.is_finite() && aperture_m > 0.0 && aperture_m <= MAX_APERTURE_M) {
         return Err(SizingError::Scene {
             key: "apertures",
             reason: format!("{aperture_m} m: an aperture is a number in (0, {MAX_APERTURE_M}] m"),
-        }
-        .into());
+        });
     }
     if scene.effects.rod_properties_csv.is_some() {
         return Err(SizingError::Scene {
             key: "effects.rod_properties_csv",
             reason: "measured rods belong to one truss; a scaled truss has other rods".into(),
-        }
-        .into());
+        });
     }
     let s = aperture_m / scene.reflector.aperture_diameter_m;
     let per_stress = membrane_tension_n(scene, 1.0);
@@ -161,13 +158,12 @@ pub fn run_aperture_study(
     scene: &Scene,
     settings: &ApertureSettings,
     observe: &mut dyn FnMut(&ApertureResult),
-) -> Result<Vec<ApertureResult>, Error> {
+) -> Result<Vec<ApertureResult>, SizingError> {
     if settings.apertures_m.is_empty() {
         return Err(SizingError::Scene {
             key: "apertures",
             reason: "no aperture given".into(),
-        }
-        .into());
+        });
     }
     let scenes = settings
         .apertures_m

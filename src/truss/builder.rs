@@ -68,12 +68,21 @@ impl RingTruss {
         layout: &RingTrussLayout,
         effects: &SceneEffects,
     ) -> Result<Self, MechanicsError> {
+        Self::from_frame(Self::builder(scene, layout, effects))
+    }
+
+    /// The truss of a frame already constructed ([`RingTruss::builder`]):
+    /// a run that needs the frame more than once constructs it once.
+    ///
+    /// # Errors
+    /// A degenerate layout (coincident hinges), named.
+    pub fn from_frame(frame: RingTrussBuilder) -> Result<Self, MechanicsError> {
         let RingTrussBuilder {
             builder,
             attachments,
             supports,
             dead_loads,
-        } = Self::builder(scene, layout, effects);
+        } = frame;
         Ok(RingTruss {
             model: builder.build()?,
             attachments,

@@ -2,7 +2,7 @@
 //! file names) becomes a [`TrussOracle`]. A new model is its own file in
 //! this module, a variant of [`TrussModel`] and one arm here.
 
-use super::builder::RingTruss;
+use super::builder::{RingTruss, RingTrussBuilder};
 use super::exact::ExactTruss;
 use super::linear::LinearTruss;
 use super::response::{TrussError, TrussOracle};
@@ -23,7 +23,21 @@ pub fn oracle(
     layout: &RingTrussLayout,
     effects: &SceneEffects,
 ) -> Result<Box<dyn TrussOracle>, TrussError> {
-    let ring = || RingTruss::new(scene, layout, effects);
+    oracle_on_frame(model, layout, || RingTruss::builder(scene, layout, effects))
+}
+
+/// The oracle of `model` on `layout`, its beam model (if it has one) made
+/// from the frame `frame` gives: a caller that keeps one frame for several
+/// stages hands out a copy; `frame` is not called for a model without one.
+///
+/// # Errors
+/// A frame that cannot be built.
+pub fn oracle_on_frame(
+    model: TrussModel,
+    layout: &RingTrussLayout,
+    frame: impl FnOnce() -> RingTrussBuilder,
+) -> Result<Box<dyn TrussOracle>, TrussError> {
+    let ring = || RingTruss::from_frame(frame());
     Ok(match model {
         TrussModel::Rigid => Box::new(RigidTruss::new(layout)),
         TrussModel::Linear => Box::new(LinearTruss::new(ring()?, layout)?),

@@ -10,9 +10,9 @@ use serde::{Deserialize, Serialize};
 use super::registry::oracle;
 use super::response::TrussError;
 use crate::effects::SceneEffects;
-use crate::fdm::solve_network;
+use crate::fdm::{solve_network, FdmError};
 use crate::geometry::build_mesh;
-use crate::scene::{Scene, TrussModel};
+use crate::scene::{Scene, SceneError, TrussModel};
 
 /// Attachment loads in a file: `{"loads_n": [[fx, fy, fz], …]}`, top hinges
 /// `0..N` then bottom hinges, N.
@@ -57,12 +57,37 @@ pub struct SceneTrussResponse {
     pub time_s: f64,
 }
 
+/// Why the `truss` command's response cannot be computed.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneResponseError {
+    /// The scene's nets cannot be built, or its loads file not read.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The net's force densities do not solve.
+    #[error(transparent)]
+    Net(#[from] FdmError),
+    /// Bad loads, or a truss that cannot respond.
+    #[error(transparent)]
+    Truss(#[from] TrussError),
+}
+
+impl SceneResponseError {
+    /// True when the input is at fault.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            SceneResponseError::Scene(_) => true,
+            SceneResponseError::Net(e) => e.is_bad_input(),
+            SceneResponseError::Truss(e) => e.is_bad_input(),
+        }
+    }
+}
+
 /// Read a loads file.
 ///
 /// # Errors
 /// I/O or a malformed file, with the path.
-pub fn read_loads(path: &Path) -> Result<LoadsFile, crate::Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| crate::SceneError::Io {
+pub fn read_loads(path: &Path) -> Result<LoadsFile, SceneResponseError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
         path: path.display().to_string(),
         source,
     })?;
@@ -84,7 +109,7 @@ pub fn respond(
     scene: &Scene,
     model: TrussModel,
     loads: Option<(String, LoadsFile)>,
-) -> Result<SceneTrussResponse, crate::Error> {
+) -> Result<SceneTrussResponse, SceneResponseError> {
     let mesh = build_mesh(scene)?;
     let (loads_from, loads_n) = match loads {
         Some((from, file)) => (from, file.loads_n),

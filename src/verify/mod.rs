@@ -14,7 +14,10 @@
 //! documents the model and its stiffening factor. [`Verification::cable_model`]
 //! says which model an assembly used.
 
+mod error;
 mod stiffening;
+
+pub use error::VerifyError;
 
 pub use crate::effects::{CableModel, INEXTENSIBLE_STIFFENING};
 
@@ -26,16 +29,12 @@ use serde::Serialize;
 
 use crate::algebra::norm3;
 use crate::effects::SceneEffects;
-use crate::geometry::ReflectorMesh;
+use crate::geometry::{ReflectorMesh, RingTrussLayout};
 use crate::mechanics::constraint_scale;
-use crate::mechanics::{
-    MechanicsError, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver, StaticTermination,
-};
+use crate::mechanics::{Model, ModelBuilder, NodeId, StaticSettings, StaticSolver};
 use crate::network::Network;
 use crate::scene::Scene;
-use crate::truss::{
-    ExactTruss, RingTruss, RingTrussBuilder, TrussEquilibrium, TrussError, TrussOracle,
-};
+use crate::truss::{ExactTruss, RingTruss, RingTrussBuilder, TrussEquilibrium, TrussOracle};
 use crate::uniformity::Design;
 
 /// What the cables are assembled on.
@@ -46,69 +45,6 @@ pub enum AssemblyTruss {
     Rigid,
     /// The scene's ring truss, geometrically exact, undeformed before assembly.
     Flexible,
-}
-
-/// An assembly that cannot be built or solved.
-#[derive(Debug, thiserror::Error)]
-pub enum VerifyError {
-    /// The design does not belong to the network.
-    #[error(
-        "verification: the design has {design_cables} cables and {design_nodes} nodes, the \
-         network {network_cables} and {network_nodes}"
-    )]
-    DesignOfAnotherNetwork {
-        /// Cables of the design.
-        design_cables: usize,
-        /// Nodes of the design.
-        design_nodes: usize,
-        /// Cables of the network.
-        network_cables: usize,
-        /// Nodes of the network.
-        network_nodes: usize,
-    },
-    /// The network's fixed nodes are not the truss's attachment points.
-    #[error(
-        "verification: the network has {fixed_nodes} fixed nodes, the truss {attachments} \
-         attachment points"
-    )]
-    NetworkOfAnotherTruss {
-        /// Fixed nodes of the network.
-        fixed_nodes: usize,
-        /// Attachment points of the truss.
-        attachments: usize,
-    },
-    /// The truss that gives the assembly its starting guess failed.
-    #[error("verification: {0}")]
-    Truss(#[from] TrussError),
-    /// The assembled model is invalid (a cable of zero length, …), named.
-    #[error("assembled model: {0}")]
-    Mechanics(#[from] MechanicsError),
-    /// The assembly found no equilibrium.
-    #[error(
-        "the assembled net and truss found no equilibrium: the solve {termination} (last \
-         converged prestrain factor {load_factor:.4})"
-    )]
-    NoEquilibrium {
-        /// How the static solve ended.
-        termination: StaticTermination,
-        /// The largest prestrain factor reached.
-        load_factor: f64,
-    },
-    /// The inextensible assembly lost its equilibrium while its cables were
-    /// stiffened from the elastic one ([`CableModel::Inextensible`]).
-    #[error(
-        "the assembled net and truss found no equilibrium with cables {stiffening:e} × stiffer \
-         than the scene's on the way to inextensible ones ({termination:?}, last converged \
-         prestrain factor {load_factor:.4} of that stage)"
-    )]
-    NoInextensibleEquilibrium {
-        /// The stiffening `EA*/EA` of the stage that failed.
-        stiffening: f64,
-        /// How the stage's static solve ended.
-        termination: StaticTermination,
-        /// The largest prestrain factor reached in that stage.
-        load_factor: f64,
-    },
 }
 
 /// The assembled equilibrium, judged against the design.
@@ -196,6 +132,40 @@ pub fn verify(
     truss: AssemblyTruss,
     equilibrium: Option<&TrussEquilibrium>,
 ) -> Result<Verification, VerifyError> {
+    let frame = match truss {
+        AssemblyTruss::Rigid => None,
+        AssemblyTruss::Flexible => Some(RingTruss::builder(scene, &mesh.truss, effects)),
+    };
+    verify_on_frame(
+        scene,
+        mesh,
+        effects,
+        network,
+        design,
+        frame.as_ref(),
+        equilibrium,
+    )
+}
+
+/// [`verify`] on the flexible truss's frame `frame` (constructed once by the
+/// caller, [`RingTruss::builder`], and copied here), or on the rigid
+/// attachment points when `frame` is `None`.
+///
+/// # Errors
+/// As [`verify`].
+pub fn verify_on_frame(
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    effects: &SceneEffects,
+    network: &Network,
+    design: &Design,
+    frame: Option<&RingTrussBuilder>,
+    equilibrium: Option<&TrussEquilibrium>,
+) -> Result<Verification, VerifyError> {
+    let truss = match frame {
+        Some(_) => AssemblyTruss::Flexible,
+        None => AssemblyTruss::Rigid,
+    };
     let clock = Instant::now();
     let n_edges = network.n_edges();
     if design.q.len() != n_edges || design.nodes_xyz_m.len() != network.n_nodes() {
@@ -220,8 +190,8 @@ pub fn verify(
         });
     }
 
-    let (mut b, attachments, dead_loads) = match truss {
-        AssemblyTruss::Rigid => {
+    let (mut b, attachments, dead_loads) = match frame {
+        None => {
             let mut b = ModelBuilder::new();
             let points = hinges
                 .iter()
@@ -233,13 +203,13 @@ pub fn verify(
                 .collect::<Vec<_>>();
             (b, points, Vec::new())
         }
-        AssemblyTruss::Flexible => {
+        Some(frame) => {
             let RingTrussBuilder {
                 builder,
                 attachments,
                 dead_loads,
                 ..
-            } = RingTruss::builder(scene, layout, effects);
+            } = frame.clone();
             (builder, attachments, dead_loads)
         }
     };
@@ -293,12 +263,10 @@ pub fn verify(
     // motion being many times the cables' elastic stretch); then, if that
     // fails, from the undeformed truss with the prestrain ramped in load steps.
     let mut found = None;
-    let guess = match (truss, equilibrium) {
-        (AssemblyTruss::Rigid, _) => None,
-        (AssemblyTruss::Flexible, Some(e)) => Some(Cow::Borrowed(e)),
-        (AssemblyTruss::Flexible, None) => {
-            truss_guess(scene, mesh, effects, design)?.map(Cow::Owned)
-        }
+    let guess = match (frame, equilibrium) {
+        (None, _) => None,
+        (Some(_), Some(e)) => Some(Cow::Borrowed(e)),
+        (Some(frame), None) => truss_guess(frame, layout, design)?.map(Cow::Owned),
     };
     if let Some(guess) = guess {
         let solver = StaticSolver::new(b.build()?)?;
@@ -415,13 +383,11 @@ pub fn verify(
 /// The flexible truss's equilibrium under the design's pull (`None` when
 /// the truss finds none): the start of the assembled solve.
 fn truss_guess(
-    scene: &Scene,
-    mesh: &ReflectorMesh,
-    effects: &SceneEffects,
+    frame: &RingTrussBuilder,
+    layout: &RingTrussLayout,
     design: &Design,
 ) -> Result<Option<TrussEquilibrium>, VerifyError> {
-    let layout = &mesh.truss;
-    let mut exact = ExactTruss::new(RingTruss::new(scene, layout, effects)?, layout)?;
+    let mut exact = ExactTruss::new(RingTruss::from_frame(frame.clone())?, layout)?;
     Ok(match exact.respond(&design.pull_n()) {
         Ok(_) => exact.equilibrium(),
         Err(_) => None,
