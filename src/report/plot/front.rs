@@ -1,0 +1,154 @@
+//! The design front: `Tmax/Tmin` against the surface RMS of a forward
+//! solve, one curve per solver, each point labelled with its knob.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::canvas::{png_and_svg, titled_with_legend};
+use super::labels::{label_font, place_labels};
+use super::RMS_FLOOR_MM;
+use crate::report::{DrawError, FrontRow, ReportError};
+
+fn draw_front<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    points: &[FrontRow],
+    failed: Option<&[(String, f64)]>,
+    title: &str,
+) -> Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    let ok: Vec<&FrontRow> = points.iter().filter(|p| p.ratio.is_finite()).collect();
+    let (plot, legend) = titled_with_legend(&root, title, 60)?;
+    let x = |p: &FrontRow| p.rms_mm.max(RMS_FLOOR_MM);
+    let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+    for p in &ok {
+        x_lo = x_lo.min(x(p));
+        x_hi = x_hi.max(x(p));
+        y_lo = y_lo.min(p.ratio);
+        y_hi = y_hi.max(p.ratio);
+    }
+    if ok.is_empty() {
+        (x_lo, x_hi, y_lo, y_hi) = (RMS_FLOOR_MM, 1.0, 1.0, 2.0);
+    }
+    let (x_lo, x_hi) = (x_lo / 2.0, (x_hi * 4.0).max(x_lo * 10.0));
+    let (y_lo, y_hi) = ((y_lo * 0.95).max(1.0 - 1e-9), y_hi * 1.05 + 1e-9);
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), y_lo..y_hi)?;
+    chart
+        .configure_mesh()
+        .x_desc("surface RMS from a forward solve (mm)")
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_desc("Tmax / Tmin")
+        .label_style(("sans-serif", 14))
+        .draw()?;
+    let mut solvers: Vec<&str> = Vec::new();
+    let failures = failed.unwrap_or_default();
+    for p in ok
+        .iter()
+        .map(|p| p.solver.as_str())
+        .chain(failures.iter().map(|f| f.0.as_str()))
+    {
+        if !solvers.contains(&p) {
+            solvers.push(p);
+        }
+    }
+    let colour = |solver: &str| {
+        Palette99::pick(solvers.iter().position(|s| *s == solver).unwrap_or(0)).to_rgba()
+    };
+    let mut anchors = Vec::new();
+    for solver in &solvers {
+        let c = colour(solver);
+        let mut series: Vec<&FrontRow> =
+            ok.iter().copied().filter(|p| p.solver == *solver).collect();
+        series.sort_by(|a, b| x(a).total_cmp(&x(b)));
+        chart.draw_series(LineSeries::new(
+            series.iter().map(|p| (x(p), p.ratio)),
+            c.stroke_width(2),
+        ))?;
+        // A point below the axis floor is drawn at it, hollow.
+        chart.draw_series(series.iter().map(|p| {
+            let style = if p.rms_mm < RMS_FLOOR_MM {
+                c.stroke_width(2)
+            } else {
+                c.filled()
+            };
+            Circle::new((x(p), p.ratio), 4, style)
+        }))?;
+        anchors.extend(series.iter().map(|p| ((x(p), p.ratio), knob_label(p.knob))));
+    }
+    // Each point labelled with its knob, where the label has room.
+    let pixels: Vec<((i32, i32), Option<&str>)> = anchors
+        .iter()
+        .map(|(p, label)| (chart.backend_coord(p), Some(label.as_str())))
+        .collect();
+    let offsets = place_labels(&pixels);
+    chart.draw_series(
+        anchors
+            .iter()
+            .zip(offsets)
+            .filter_map(|((p, label), offset)| {
+                let offset = offset?;
+                Some(EmptyElement::at(*p) + Text::new(label.clone(), offset, label_font()))
+            }),
+    )?;
+    // The legend below the plot: the solvers, the floor, the failures.
+    let font = ("sans-serif", 14).into_font();
+    let mut at = 70;
+    for solver in &solvers {
+        let c = colour(solver);
+        legend.draw(&PathElement::new(
+            vec![(at, 14), (at + 22, 14)],
+            c.stroke_width(2),
+        ))?;
+        legend.draw(&Text::new(solver.to_string(), (at + 28, 6), font.clone()))?;
+        at += 50 + 8 * solver.len() as i32;
+    }
+    legend.draw(&Circle::new((at, 14), 4, BLACK.stroke_width(2)))?;
+    legend.draw(&Text::new(
+        format!("RMS below {RMS_FLOOR_MM:.0e} mm, drawn at it; labels: the knob"),
+        (at + 10, 6),
+        font.clone(),
+    ))?;
+    let failures = match failed {
+        None => "failed points: not recorded in shards (see each shard's run)".to_string(),
+        Some([]) => "no failed point".to_string(),
+        Some(failed) => {
+            let list: Vec<String> = failed
+                .iter()
+                .map(|(solver, knob)| format!("{solver} at {knob:.0e}"))
+                .collect();
+            format!("failed, no design (not drawn): {}", list.join(", "))
+        }
+    };
+    legend.draw(&Text::new(failures, (70, 32), font))?;
+    Ok(root.present()?)
+}
+
+/// Draws the design front (ratio against actual surface RMS, one curve per
+/// solver, each point labelled with its knob where there is room; a point
+/// below the RMS floor drawn hollow at it) as PNG and SVG, each written
+/// atomically; the legend, below the plot, lists the `failed` points
+/// (solver, knob), or says they are unknown (`None`: a merged front).
+pub fn front_plot(
+    points: &[FrontRow],
+    failed: Option<&[(String, f64)]>,
+    title: &str,
+    png: &Path,
+    svg: &Path,
+) -> Result<(), ReportError> {
+    png_and_svg!(draw_front, (1000, 680), png, svg, points, failed, title)
+}
+
+/// A knob value as a point's label: one significant digit.
+fn knob_label(knob: f64) -> String {
+    if knob == 0.0 {
+        "0".into()
+    } else {
+        format!("{knob:.0e}")
+    }
+}
