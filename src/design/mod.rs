@@ -33,8 +33,7 @@ mod scene_nets;
 mod tied_nets;
 
 pub use outer_loop::{
-    design_loop, design_loop_with, IterationRecord, LoopOutcome, LoopSettings, LoopTermination,
-    DIVERGENCE_FACTOR,
+    design_loop, design_loop_with, IterationRecord, LoopOutcome, LoopSettings, DIVERGENCE_FACTOR,
 };
 pub use pipeline::{design_margin, run, DesignReport, DesignRun, DesignSettings, LoopRun, Timings};
 pub use relaxation::{
@@ -43,8 +42,9 @@ pub use relaxation::{
 pub use scene_nets::{default_solver, scene_problem, SceneNets};
 pub use tied_nets::{TiedDesign, TiedNets};
 
+use crate::status::Termination;
 use crate::truss::TrussError;
-use crate::uniformity::{Termination, UniformityError};
+use crate::uniformity::UniformityError;
 
 /// The outer loop cannot go on.
 #[derive(Debug, thiserror::Error)]

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings, LoopTermination};
+use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings};
 use super::relaxation::RelaxationKind;
 use super::scene_nets::{default_solver, SceneNets};
 use super::DesignError;
@@ -18,6 +18,7 @@ use crate::geometry::ReflectorMesh;
 use crate::mechanics::LimitSearch;
 use crate::network::Network;
 use crate::scene::{Scene, TrussModel};
+use crate::status::Termination;
 use crate::truss::{RingTruss, TrussError};
 use crate::uniformity::{Design, SolverKind, UniformitySet};
 use crate::verify::{verify, AssemblyTruss, Verification};
@@ -59,7 +60,7 @@ pub struct LoopRun {
     /// The policy.
     pub relaxation: RelaxationKind,
     /// How it ended.
-    pub termination: LoopTermination,
+    pub termination: Termination,
     /// Outer iterations (designs made).
     pub outer_iterations: usize,
     /// Final `‖G(C) − C‖∞`, m.
@@ -153,7 +154,7 @@ pub struct DesignReport {
     /// The relaxation policy that made the design.
     pub relaxation: RelaxationKind,
     /// How the loop ended.
-    pub termination: LoopTermination,
+    pub termination: Termination,
     /// Outer iterations.
     pub outer_iterations: usize,
     /// Final fixed-point residual `‖G(C) − C‖∞`, m.
@@ -270,7 +271,7 @@ pub fn run(
             // A comparison run may fail without losing the design.
             Err(e) if outcome.is_some() => runs.push(LoopRun {
                 relaxation,
-                termination: LoopTermination::Diverged,
+                termination: Termination::Diverged,
                 outer_iterations: history.len(),
                 boundary_residual_m: history.last().map_or(f64::NAN, |r| r.boundary_change_max_m),
                 time_s: history.last().map_or(0.0, |r| r.elapsed_s),

@@ -6,8 +6,10 @@ use serde::Serialize;
 
 use super::assembly::State;
 use super::model::MechanicsError;
+use crate::status::{Status, Termination};
 
-/// How a static solve ended.
+/// How a static solve ended: the crate's shared reason ([`Status`]) with the
+/// load factor it reached.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "status", rename_all = "snake_case")]
 pub enum StaticTermination {
@@ -47,6 +49,22 @@ pub enum StaticTermination {
         /// Last converged load factor.
         load_factor: f64,
     },
+}
+
+impl Status for StaticTermination {
+    /// `LimitPoint` is [`Termination::Infeasible`] (no equilibrium at the
+    /// full load on the branch followed), `MaxSteps`
+    /// [`Termination::MaxIterations`], `Overflow`
+    /// [`Termination::NumericalError`]; the others their namesakes.
+    fn termination(&self) -> Termination {
+        match self {
+            StaticTermination::Converged => Termination::Converged,
+            StaticTermination::Stalled { .. } => Termination::Stalled,
+            StaticTermination::LimitPoint { .. } => Termination::Infeasible,
+            StaticTermination::MaxSteps { .. } => Termination::MaxIterations,
+            StaticTermination::Overflow { .. } => Termination::NumericalError,
+        }
+    }
 }
 
 impl std::fmt::Display for StaticTermination {
@@ -211,6 +229,6 @@ pub struct StaticSolution {
 impl StaticSolution {
     /// True at equilibrium under the full load.
     pub fn converged(&self) -> bool {
-        self.termination == StaticTermination::Converged
+        self.termination.converged()
     }
 }

@@ -54,10 +54,11 @@ pub use aperture::{
 };
 pub use pareto::pareto_optimal;
 
+use crate::design::LoopSettings;
 use crate::design::{default_solver, SceneNets};
-use crate::design::{LoopSettings, LoopTermination};
 use crate::scene::{Scene, TrussModel, MAX_ELEMENTS_PER_ROD};
 use crate::shard::Shard;
+use crate::status::Termination;
 use crate::uniformity::SolverKind;
 use crate::verify::{verify, AssemblyTruss};
 
@@ -393,7 +394,7 @@ pub struct StudyRow {
     /// Outer iterations.
     pub outer_iterations: Option<usize>,
     /// How the loop ended.
-    pub termination: Option<LoopTermination>,
+    pub termination: Option<Termination>,
     /// Final `‖G(C) − C‖∞`, m.
     pub boundary_residual_m: f64,
     /// The design's `Tmax/Tmin` (largest set).
@@ -428,7 +429,7 @@ impl StudyRow {
 /// What the outer loop made.
 struct LoopSummary {
     iterations: usize,
-    termination: LoopTermination,
+    termination: Termination,
     residual_m: f64,
     ratio: f64,
 }
@@ -622,7 +623,7 @@ pub fn run_study(
         message,
     };
     if let Some(s) = measured.summary.as_ref() {
-        if s.termination != LoopTermination::Converged {
+        if s.termination != Termination::Converged {
             return Err(failed(format!(
                 "its outer loop stopped {:?} after {} iterations (residual {:.3e} m): a \
                  yardstick must be converged",
