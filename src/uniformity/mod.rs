@@ -28,7 +28,7 @@ pub use design::{Design, Route, SlackNodes, TensionSpread};
 pub use front::{
     design_front, design_front_points, front_jobs, knob_values, FrontPoint, KnobRange,
 };
-pub use gradient::{Gradient, History};
+pub use gradient::{FinishSettings, Gradient, History};
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
 pub use problem::{SurfaceTarget, UniformityProblem, UniformitySet};

@@ -34,7 +34,8 @@ fn the_interior_point_and_clarabel_agree_on_the_step_programs() {
             };
             let objective = Objective::new(&settings, &problem);
             for radius in [0.01, 0.5] {
-                let (model, eq) = step_model(&objective, &q, radius).expect("model");
+                let (model, eq) =
+                    step_model(&objective, &q, radius, &FinishSettings::default()).expect("model");
                 let feasible = |z: &[f64]| model.feasible_point(z, |rhs| eq.solve_d(rhs));
                 let ours = feasible(&ipm::solve(&model, None, false).expect("interior point").0);
                 let theirs = feasible(&model.solve_with_clarabel().expect("clarabel"));
