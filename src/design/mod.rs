@@ -40,7 +40,7 @@ pub use relaxation::{
     aitken_factor, paper_step, Aitken, Anderson, Paper, Relaxation, RelaxationKind, Step,
 };
 pub use scene_nets::{default_solver, scene_problem, SceneNets};
-pub use tied_nets::{TiedDesign, TiedNets};
+pub use tied_nets::{TiedDesign, TiedNetSettings, TiedNets};
 
 use crate::status::Termination;
 use crate::truss::TrussError;
@@ -52,7 +52,8 @@ pub enum DesignError {
     /// An invalid loop setting.
     #[error("design loop setting `{key}`: {reason}")]
     Setting {
-        /// The setting (`tolerance_m`, `max_iterations`, `anderson_depth`).
+        /// The setting (`tolerance_m`, `max_iterations`, `anderson_depth`,
+        /// `tied_nets.…`).
         key: &'static str,
         /// Why the value is refused.
         reason: String,

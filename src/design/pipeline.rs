@@ -12,6 +12,7 @@ use serde::Serialize;
 use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings};
 use super::relaxation::RelaxationKind;
 use super::scene_nets::{default_solver, SceneNets};
+use super::tied_nets::TiedNetSettings;
 use super::DesignError;
 use crate::effects::SceneEffects;
 use crate::geometry::ReflectorMesh;
@@ -39,6 +40,8 @@ pub struct DesignSettings {
     pub tolerance_m: f64,
     /// Most outer iterations.
     pub max_iterations: usize,
+    /// Tolerances and budgets of the two-stage design of each iteration.
+    pub tied_nets: TiedNetSettings,
 }
 
 impl Default for DesignSettings {
@@ -50,6 +53,7 @@ impl Default for DesignSettings {
             relaxations: vec![loop_settings.relaxation],
             tolerance_m: loop_settings.tolerance_m,
             max_iterations: loop_settings.max_iterations,
+            tied_nets: TiedNetSettings::default(),
         }
     }
 }
@@ -220,7 +224,16 @@ pub fn run(
     let clock = Instant::now();
     let mut timings = Timings::default();
     let model = settings.truss.unwrap_or(scene.effects.truss);
-    let scene_nets = SceneNets::new(scene)?;
+    let SceneNets {
+        mesh,
+        nets,
+        effects,
+    } = SceneNets::new(scene)?;
+    let scene_nets = SceneNets {
+        nets: nets.with_settings(settings.tied_nets.clone())?,
+        mesh,
+        effects,
+    };
     timings.mesh_s = clock.elapsed().as_secs_f64();
     let (mesh, nets) = (&scene_nets.mesh, &scene_nets.nets);
     let solver = settings

@@ -232,3 +232,45 @@ impl StaticSolution {
         self.termination.converged()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every static ending reads as one shared reason, and only equilibrium
+    /// at the full load is `Converged`; the JSON keeps its `status` tag.
+    #[test]
+    fn static_terminations_read_as_the_shared_reasons() {
+        let cases = [
+            (StaticTermination::Converged, Termination::Converged),
+            (
+                StaticTermination::Stalled { load_factor: 0.5 },
+                Termination::Stalled,
+            ),
+            (
+                StaticTermination::LimitPoint {
+                    limit_load_factor: 0.6555,
+                },
+                Termination::Infeasible,
+            ),
+            (
+                StaticTermination::MaxSteps { load_factor: 0.9 },
+                Termination::MaxIterations,
+            ),
+            (
+                StaticTermination::Overflow { load_factor: 0.1 },
+                Termination::NumericalError,
+            ),
+        ];
+        for (ending, reason) in cases {
+            assert_eq!(ending.termination(), reason, "{ending}");
+            assert_eq!(ending.converged(), reason == Termination::Converged);
+        }
+        let json = serde_json::to_value(StaticTermination::LimitPoint {
+            limit_load_factor: 0.5,
+        })
+        .unwrap();
+        assert_eq!(json["status"], "limit_point");
+        assert_eq!(json["limit_load_factor"], 0.5);
+    }
+}

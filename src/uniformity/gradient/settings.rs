@@ -237,3 +237,76 @@ impl FinishSettings {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each out-of-range finish setting is refused by its dotted name, and
+    /// through the solver's own check.
+    #[test]
+    fn finish_settings_out_of_range_are_named() {
+        assert!(Gradient::default().validate().is_ok());
+        let cases = [
+            (
+                FinishSettings {
+                    tolerance: f64::NAN,
+                    ..FinishSettings::default()
+                },
+                "finish.tolerance",
+            ),
+            (
+                FinishSettings {
+                    max_steps: 0,
+                    ..FinishSettings::default()
+                },
+                "finish.max_steps",
+            ),
+            (
+                FinishSettings {
+                    max_radius: 1.0,
+                    ..FinishSettings::default()
+                },
+                "finish.max_radius",
+            ),
+            (
+                FinishSettings {
+                    first_radius: 0.6,
+                    ..FinishSettings::default()
+                },
+                "finish.first_radius",
+            ),
+            (
+                FinishSettings {
+                    min_radius: 0.0,
+                    ..FinishSettings::default()
+                },
+                "finish.min_radius",
+            ),
+            (
+                FinishSettings {
+                    outside_reach: -1.0,
+                    ..FinishSettings::default()
+                },
+                "finish.outside_reach",
+            ),
+            (
+                FinishSettings {
+                    max_fall: 1.0,
+                    ..FinishSettings::default()
+                },
+                "finish.max_fall",
+            ),
+        ];
+        for (finish, field) in cases {
+            let gradient = Gradient {
+                finish,
+                ..Gradient::default()
+            };
+            match gradient.validate() {
+                Err(UniformityError::Setting { name, .. }) => assert_eq!(name, field),
+                other => panic!("{field}: {other:?}"),
+            }
+        }
+    }
+}
