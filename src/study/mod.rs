@@ -54,8 +54,7 @@ pub use aperture::{
 };
 pub use pareto::pareto_optimal;
 
-use crate::design::LoopSettings;
-use crate::design::{default_solver, SceneNets};
+use crate::design::{default_solver, LoopSettings, SceneNets};
 use crate::scene::{Scene, TrussModel, MAX_ELEMENTS_PER_ROD};
 use crate::shard::Shard;
 use crate::status::Termination;
