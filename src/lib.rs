@@ -10,6 +10,8 @@
 //!
 //! The pipeline, layer by layer:
 //!
+//! * [`status`] — how an iterative computation ends ([`Termination`]), one
+//!   vocabulary for the solvers, the outer loop and the statics engine;
 //! * [`scene`] — the problem file (TOML), validated once into a [`Scene`];
 //! * [`geometry`] — the paraboloid, the ring-truss layout and the net generators,
 //!   which turn a scene into a cable [`Network`];
@@ -49,6 +51,7 @@ pub mod run;
 pub mod scene;
 pub mod shard;
 pub mod sizing;
+pub mod status;
 pub mod study;
 pub mod truss;
 pub mod uniformity;
@@ -57,6 +60,7 @@ pub mod verify;
 pub use fdm::{Equilibrium, FdmError, FdmStructure};
 pub use network::{CableGroup, Network, NetworkError};
 pub use scene::{Scene, SceneError};
+pub use status::{Status, Termination};
 
 /// Every error the library returns, one variant per module.
 #[derive(Debug, thiserror::Error)]

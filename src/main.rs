@@ -447,6 +447,7 @@ fn main() -> ExitCode {
                 relaxations: relaxation.clone(),
                 tolerance_m: *tol,
                 max_iterations: *max_iterations,
+                ..Default::default()
             };
             ringmesh::run::design(scene, &options, output.as_deref(), &mut |relaxation, r| {
                 eprintln!(

@@ -5,7 +5,7 @@
 
 mod common;
 
-use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind};
+use ringmesh::design::{design_loop, LoopSettings, RelaxationKind};
 use ringmesh::effects::SceneEffects;
 use ringmesh::geometry::ReflectorMesh;
 use ringmesh::scene::{Scene, TrussModel};
@@ -13,6 +13,7 @@ use ringmesh::truss::layout_points;
 use ringmesh::uniformity::{Design, SolverKind};
 use ringmesh::verify::{verify, AssemblyTruss, CableModel, Verification, INEXTENSIBLE_STIFFENING};
 use ringmesh::Network;
+use ringmesh::Termination;
 
 fn inextensible(scene: &Scene) -> Scene {
     let mut s = scene.clone();
@@ -128,7 +129,7 @@ fn the_design_for_the_deforming_truss_survives_inextensible_assembly() {
         &mut |_| {},
     )
     .unwrap();
-    assert_eq!(outcome.termination, LoopTermination::Converged);
+    assert_eq!(outcome.termination, Termination::Converged);
     let network = outcome.problem.network();
     for s in [scene.clone(), inextensible(&scene)] {
         let v = assemble(&s, &mesh, network, &outcome.design, AssemblyTruss::Flexible);

@@ -3,7 +3,7 @@
 
 mod common;
 
-use ringmesh::design::{design_loop, LoopSettings, LoopTermination, RelaxationKind, TiedNets};
+use ringmesh::design::{design_loop, LoopSettings, RelaxationKind, TiedNets};
 use ringmesh::design::{scene_problem, DesignSettings};
 use ringmesh::effects::SceneEffects;
 use ringmesh::mechanics::LimitBound;
@@ -12,6 +12,7 @@ use ringmesh::scene::{Scene, TrussModel};
 use ringmesh::truss::{layout_points, limit_margin, RingTruss, MARGIN_PRECISION, MARGIN_SEARCH_TO};
 use ringmesh::uniformity::SolverKind;
 use ringmesh::verify::{verify, AssemblyTruss};
+use ringmesh::Termination;
 
 fn settings(relaxation: RelaxationKind) -> LoopSettings {
     LoopSettings {
@@ -38,7 +39,7 @@ fn exact_truss_design_survives_assembly_and_the_conventional_one_does_not() {
         &mut |_| {},
     )
     .unwrap();
-    assert_eq!(outcome.termination, LoopTermination::Converged);
+    assert_eq!(outcome.termination, Termination::Converged);
     assert!(outcome.boundary_residual_m() <= 1e-7);
     let designed = verify(
         &scene,
@@ -232,7 +233,7 @@ fn rigid_truss_loop_stops_after_one_design() {
             &mut |_| {},
         )
         .unwrap();
-        assert_eq!(outcome.termination, LoopTermination::Converged);
+        assert_eq!(outcome.termination, Termination::Converged);
         assert_eq!(outcome.history.len(), 1);
         assert_eq!(outcome.boundary_residual_m(), 0.0);
     }
@@ -256,7 +257,7 @@ fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
         .unwrap();
         assert_eq!(
             outcome.termination,
-            LoopTermination::Converged,
+            Termination::Converged,
             "{relaxation:?}"
         );
         assert!(outcome.boundary_residual_m() <= 1e-7);

@@ -5,14 +5,14 @@
 mod common;
 
 use ringmesh::design::{
-    design_loop, design_loop_with, LoopSettings, LoopTermination, Relaxation, RelaxationKind,
-    SceneNets, Step,
+    design_loop, design_loop_with, LoopSettings, Relaxation, RelaxationKind, SceneNets, Step,
 };
 use ringmesh::effects::{Effect, SceneEffects};
 use ringmesh::network::CableGroup;
 use ringmesh::scene::TrussModel;
 use ringmesh::truss::{self, layout_points};
 use ringmesh::uniformity::SolverKind;
+use ringmesh::Termination;
 
 /// A toy relaxation: a fixed under-relaxation `x + ω r`.
 struct Damped {
@@ -80,7 +80,7 @@ fn a_relaxation_policy_defined_outside_the_crate_runs_the_loop() {
         &mut |_| {},
     )
     .unwrap();
-    assert_eq!(toy.termination, LoopTermination::Converged);
+    assert_eq!(toy.termination, Termination::Converged);
     assert!(toy.history.iter().all(|r| r.relaxation_factor == 0.5));
 
     let mut oracle = truss::oracle(TrussModel::Exact, &scene, &mesh.truss, &effects).unwrap();
@@ -165,7 +165,7 @@ fn an_effect_defined_outside_the_crate_acts_on_the_nets_and_the_loop() {
             &mut |_| {},
         )
         .unwrap();
-    assert_eq!(outcome.termination, LoopTermination::Converged);
+    assert_eq!(outcome.termination, Termination::Converged);
     let design = &outcome.design;
     assert!(
         design.max_residual_n <= 1e-8 * design.max_tension_n,

@@ -7,7 +7,7 @@
 mod common;
 
 use ringmesh::algebra::norm2;
-use ringmesh::design::{LoopSettings, LoopTermination, SceneNets};
+use ringmesh::design::{LoopSettings, SceneNets};
 use ringmesh::geometry::build_mesh;
 use ringmesh::scene::TrussModel;
 use ringmesh::uniformity::{
@@ -379,7 +379,7 @@ fn the_design_loop_converges_with_the_gradient_solver() {
                 .unwrap();
             assert_eq!(
                 outcome.termination,
-                LoopTermination::Converged,
+                Termination::Converged,
                 "{name}, {kind:?}: {:?}",
                 outcome.history.last()
             );

@@ -3,12 +3,13 @@
 
 mod common;
 
-use ringmesh::design::{DesignSettings, LoopSettings, LoopTermination, SceneNets};
+use ringmesh::design::{DesignSettings, LoopSettings, SceneNets};
 use ringmesh::geometry::build_mesh;
 use ringmesh::run::design;
 use ringmesh::scene::{membrane_tension_n, Scene, TrussModel};
 use ringmesh::uniformity::SolverKind;
 use ringmesh::verify::{verify, AssemblyTruss};
+use ringmesh::Termination;
 
 /// `T = 2 N A / Σ ℓ` on the hexagon's three-direction grid tends to the
 /// equilateral net's `T = N a/√3` (spacing `a = R/r`) as the grid is refined,
@@ -182,7 +183,7 @@ fn a_120_bay_ring_assembles_from_the_loops_truss_equilibrium() {
             &mut |_| {},
         )
         .unwrap();
-    assert_eq!(outcome.termination, LoopTermination::Converged);
+    assert_eq!(outcome.termination, Termination::Converged);
     let equilibrium = outcome.truss_equilibrium.as_ref();
     assert!(equilibrium.is_some(), "the exact truss has a frame state");
     let v = verify(

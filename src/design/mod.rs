@@ -33,19 +33,19 @@ mod scene_nets;
 mod tied_nets;
 
 pub use outer_loop::{
-    design_loop, design_loop_with, IterationRecord, LoopOutcome, LoopSettings, LoopTermination,
-    DIVERGENCE_FACTOR,
+    design_loop, design_loop_with, IterationRecord, LoopOutcome, LoopSettings, DIVERGENCE_FACTOR,
 };
 pub use pipeline::{design_margin, run, DesignReport, DesignRun, DesignSettings, LoopRun, Timings};
 pub use relaxation::{
     aitken_factor, paper_step, Aitken, Anderson, Paper, Relaxation, RelaxationKind, Step,
 };
 pub use scene_nets::{default_solver, scene_problem, SceneNets};
-pub use tied_nets::{TiedDesign, TiedNets};
+pub use tied_nets::{TiedDesign, TiedNetSettings, TiedNets};
 
 use crate::scene::SceneError;
+use crate::status::Termination;
 use crate::truss::TrussError;
-use crate::uniformity::{Termination, UniformityError};
+use crate::uniformity::UniformityError;
 use crate::verify::VerifyError;
 
 /// The outer loop cannot go on.
@@ -54,7 +54,8 @@ pub enum DesignError {
     /// An invalid loop setting.
     #[error("design loop setting `{key}`: {reason}")]
     Setting {
-        /// The setting (`tolerance_m`, `max_iterations`, `anderson_depth`).
+        /// The setting (`tolerance_m`, `max_iterations`, `anderson_depth`,
+        /// `tied_nets.…`).
         key: &'static str,
         /// Why the value is refused.
         reason: String,

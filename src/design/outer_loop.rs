@@ -10,8 +10,9 @@ use super::relaxation::{Relaxation, RelaxationKind};
 use super::tied_nets::{TiedDesign, TiedNets};
 use super::DesignError;
 use crate::algebra::norm3;
+use crate::status::Termination;
 use crate::truss::{TrussEquilibrium, TrussOracle};
-use crate::uniformity::{Design, Termination, UniformityProblem, UniformitySolver};
+use crate::uniformity::{Design, UniformityProblem, UniformitySolver};
 
 /// Settings of the outer loop: plain data with defaults.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -93,21 +94,8 @@ pub struct IterationRecord {
     pub elapsed_s: f64,
 }
 
-/// How the loop ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LoopTermination {
-    /// `‖G(C_k) − C_k‖∞ ≤ tol`.
-    Converged,
-    /// The iteration budget ran out first.
-    MaxIterations,
-    /// The residual grew past [`DIVERGENCE_FACTOR`] × its first value: the
-    /// policy cannot converge on this problem.
-    Diverged,
-}
-
 /// A residual this many times the first iteration's ends the loop as
-/// [`LoopTermination::Diverged`].
+/// [`Termination::Diverged`].
 pub const DIVERGENCE_FACTOR: f64 = 100.0;
 
 /// The converged (or last) design of the outer loop.
@@ -135,8 +123,11 @@ pub struct LoopOutcome {
     pub truss_equilibrium: Option<TrussEquilibrium>,
     /// One record per outer iteration.
     pub history: Vec<IterationRecord>,
-    /// How the loop ended.
-    pub termination: LoopTermination,
+    /// How the loop ended: `Converged` (`‖G(C_k) − C_k‖∞ ≤ tol`),
+    /// `MaxIterations` (the budget ran out first) or `Diverged` (the residual
+    /// grew past [`DIVERGENCE_FACTOR`] × its first value: the policy cannot
+    /// converge on this problem).
+    pub termination: Termination,
     /// Wall time, s.
     pub time_s: f64,
 }
@@ -265,11 +256,11 @@ pub fn design_loop_with(
                 truss_equilibrium: oracle.equilibrium(),
                 history,
                 termination: if converged {
-                    LoopTermination::Converged
+                    Termination::Converged
                 } else if diverged {
-                    LoopTermination::Diverged
+                    Termination::Diverged
                 } else {
-                    LoopTermination::MaxIterations
+                    Termination::MaxIterations
                 },
                 time_s: clock.elapsed().as_secs_f64(),
             });

@@ -9,14 +9,16 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings, LoopTermination};
+use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings};
 use super::relaxation::RelaxationKind;
 use super::scene_nets::{default_solver, SceneNets};
+use super::tied_nets::TiedNetSettings;
 use super::DesignError;
 use crate::geometry::ReflectorMesh;
 use crate::mechanics::LimitSearch;
 use crate::network::Network;
 use crate::scene::{Scene, TrussModel};
+use crate::status::Termination;
 use crate::truss::{RingTruss, RingTrussBuilder, TrussError};
 use crate::uniformity::{Design, SolverKind, UniformitySet};
 use crate::verify::{verify_on_frame, Verification};
@@ -36,6 +38,8 @@ pub struct DesignSettings {
     pub tolerance_m: f64,
     /// Most outer iterations.
     pub max_iterations: usize,
+    /// Tolerances and budgets of the two-stage design of each iteration.
+    pub tied_nets: TiedNetSettings,
 }
 
 impl Default for DesignSettings {
@@ -47,6 +51,7 @@ impl Default for DesignSettings {
             relaxations: vec![loop_settings.relaxation],
             tolerance_m: loop_settings.tolerance_m,
             max_iterations: loop_settings.max_iterations,
+            tied_nets: TiedNetSettings::default(),
         }
     }
 }
@@ -57,7 +62,7 @@ pub struct LoopRun {
     /// The policy.
     pub relaxation: RelaxationKind,
     /// How it ended.
-    pub termination: LoopTermination,
+    pub termination: Termination,
     /// Outer iterations (designs made).
     pub outer_iterations: usize,
     /// Final `‖G(C) − C‖∞`, m.
@@ -151,7 +156,7 @@ pub struct DesignReport {
     /// The relaxation policy that made the design.
     pub relaxation: RelaxationKind,
     /// How the loop ended.
-    pub termination: LoopTermination,
+    pub termination: Termination,
     /// Outer iterations.
     pub outer_iterations: usize,
     /// Final fixed-point residual `‖G(C) − C‖∞`, m.
@@ -217,7 +222,8 @@ pub fn run(
     let clock = Instant::now();
     let mut timings = Timings::default();
     let model = settings.truss.unwrap_or(scene.effects.truss);
-    let scene_nets = SceneNets::new(scene)?;
+    let mut scene_nets = SceneNets::new(scene)?;
+    scene_nets.nets = scene_nets.nets.with_settings(settings.tied_nets.clone())?;
     timings.mesh_s = clock.elapsed().as_secs_f64();
     let (mesh, nets) = (&scene_nets.mesh, &scene_nets.nets);
     let solver = settings
@@ -268,7 +274,7 @@ pub fn run(
             // A comparison run may fail without losing the design.
             Err(e) if outcome.is_some() => runs.push(LoopRun {
                 relaxation,
-                termination: LoopTermination::Diverged,
+                termination: Termination::Diverged,
                 outer_iterations: history.len(),
                 boundary_residual_m: history.last().map_or(f64::NAN, |r| r.boundary_change_max_m),
                 time_s: history.last().map_or(0.0, |r| r.elapsed_s),

@@ -47,6 +47,9 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
+use serde::{Deserialize, Serialize};
+
+use super::DesignError;
 
 use crate::algebra::Plain;
 use crate::effects::SceneEffects;
@@ -57,30 +60,78 @@ use crate::uniformity::{
     most_uniform, Design, UniformityError, UniformityProblem, UniformitySet, UniformitySolver,
 };
 
-/// For a solver whose optimum is a face (`lp`, `bisection`), the front stage
-/// takes the design closest to uniform tension with each set's ratio within
-/// this fraction of the solver's: unique, and continuous in the boundary.
-pub const SELECTION_SLACK: f64 = 1e-3;
+/// The two-stage design's tolerances and budgets: plain data with defaults
+/// and one `validate()` ([`TiedNets::with_settings`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TiedNetSettings {
+    /// For a solver whose optimum is a face (`lp`, `bisection`), the front
+    /// stage takes the design closest to uniform tension with each set's
+    /// ratio within this fraction of the solver's: unique, and continuous in
+    /// the boundary.
+    pub selection_slack: f64,
+    /// Relative change of the lumped cable weights at which a design under
+    /// gravity stops repeating its stages.
+    pub weight_tolerance: f64,
+    /// Most passes of the stages under gravity.
+    pub max_weight_passes: usize,
+    /// Plan offset of a tie's anchor from its node below which the tie hangs
+    /// plumb, m.
+    pub plumb_tolerance_m: f64,
+    /// Most forward solves that plumb the ties (0: the ties stay where the
+    /// front stage left their anchors).
+    pub plumb_passes: usize,
+    /// Relative error, in `ln`, at which the rear net holds its mean tension.
+    pub rear_level_tolerance: f64,
+    /// Most secant steps on the rear level (0: the vertical-balance fit,
+    /// with a warning if it misses).
+    pub rear_level_steps: usize,
+}
 
-/// Relative change of the lumped cable weights at which a design under
-/// gravity stops repeating its stages.
-const WEIGHT_TOLERANCE: f64 = 1e-13;
+impl Default for TiedNetSettings {
+    fn default() -> Self {
+        TiedNetSettings {
+            selection_slack: 1e-3,
+            weight_tolerance: 1e-13,
+            max_weight_passes: 8,
+            plumb_tolerance_m: 1e-13,
+            plumb_passes: 6,
+            rear_level_tolerance: 1e-13,
+            rear_level_steps: 20,
+        }
+    }
+}
 
-/// Most passes of the stages under gravity.
-const MAX_WEIGHT_PASSES: usize = 8;
-
-/// Plan offset of a tie's anchor from its node below which the tie hangs
-/// plumb, m.
-const PLUMB_TOLERANCE_M: f64 = 1e-13;
-
-/// Most forward solves that plumb the ties.
-const PLUMB_PASSES: usize = 6;
-
-/// Relative error, in `ln`, at which the rear net holds its mean tension.
-const REAR_LEVEL_TOLERANCE: f64 = 1e-13;
-
-/// Most secant steps on the rear level.
-const REAR_LEVEL_STEPS: usize = 20;
+impl TiedNetSettings {
+    /// Check the settings.
+    ///
+    /// # Errors
+    /// [`DesignError::Setting`] naming the first field (`tied_nets.…`) out of
+    /// its range: a slack or tolerance that is negative or not finite, or no
+    /// pass of the stages.
+    pub fn validate(&self) -> Result<(), DesignError> {
+        for (key, value) in [
+            ("tied_nets.selection_slack", self.selection_slack),
+            ("tied_nets.weight_tolerance", self.weight_tolerance),
+            ("tied_nets.plumb_tolerance_m", self.plumb_tolerance_m),
+            ("tied_nets.rear_level_tolerance", self.rear_level_tolerance),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(DesignError::Setting {
+                    key,
+                    reason: format!("{value} must be finite and ≥ 0"),
+                });
+            }
+        }
+        if self.max_weight_passes == 0 {
+            return Err(DesignError::Setting {
+                key: "tied_nets.max_weight_passes",
+                reason: "must be at least 1".into(),
+            });
+        }
+        Ok(())
+    }
+}
 
 /// What stage 2 finds: the rear force densities and node positions (the rear
 /// net's numbering), the level `α`, and a warning if the level missed.
@@ -121,6 +172,8 @@ pub struct TiedNets {
     mesh: ReflectorMesh,
     /// The effects that load the nets (the cables' self weight).
     effects: SceneEffects,
+    /// Tolerances and budgets of the stages.
+    settings: TiedNetSettings,
 }
 
 /// A two-stage design on one boundary.
@@ -239,6 +292,7 @@ impl TiedNets {
             ties,
             mesh: mesh.clone(),
             effects: SceneEffects::none(),
+            settings: TiedNetSettings::default(),
         })
     }
 
@@ -252,6 +306,21 @@ impl TiedNets {
     pub fn with_effects(mut self, effects: &SceneEffects) -> Self {
         self.effects = effects.clone();
         self
+    }
+
+    /// The same nets designed with `settings` (the defaults otherwise).
+    ///
+    /// # Errors
+    /// Settings out of range ([`TiedNetSettings::validate`]).
+    pub fn with_settings(mut self, settings: TiedNetSettings) -> Result<Self, DesignError> {
+        settings.validate()?;
+        self.settings = settings;
+        Ok(self)
+    }
+
+    /// The tolerances and budgets the stages run with.
+    pub fn settings(&self) -> &TiedNetSettings {
+        &self.settings
     }
 
     /// The two-stage design for attachment points `boundary_m` (top hinges,
@@ -323,7 +392,8 @@ impl TiedNets {
             };
             let change = max_difference(&new, weights.as_deref().unwrap_or(&[]));
             let scale = max_difference(&new, &[]);
-            if change <= WEIGHT_TOLERANCE * scale || passes >= MAX_WEIGHT_PASSES {
+            let settings = &self.settings;
+            if change <= settings.weight_tolerance * scale || passes >= settings.max_weight_passes {
                 // The weights of this pass: the design balances them exactly.
                 break (front_design, q, alpha);
             }
@@ -383,7 +453,7 @@ impl TiedNets {
             let bounds: Vec<f64> = front_design
                 .sets
                 .iter()
-                .map(|s| s.ratio * (1.0 + SELECTION_SLACK))
+                .map(|s| s.ratio * (1.0 + self.settings.selection_slack))
                 .collect();
             let mut selected = most_uniform(&front, &front_design.solver, &bounds)?.feasible()?;
             selected.iterations += front_design.iterations;
@@ -446,7 +516,7 @@ impl TiedNets {
     ) -> Result<(UniformityProblem, Design), UniformityError> {
         let n_front = self.n_front;
         let mut last = f64::INFINITY;
-        for _ in 0..PLUMB_PASSES {
+        for _ in 0..self.settings.plumb_passes {
             let mut nodes = front.network().nodes.clone();
             let mut offset: f64 = 0.0;
             for (t, &(_, i, _)) in self.ties.iter().enumerate() {
@@ -454,7 +524,7 @@ impl TiedNets {
                 offset = offset.max((top[0] - anchor[0]).hypot(top[1] - anchor[1]));
                 anchor[..2].copy_from_slice(&top[..2]);
             }
-            if offset <= PLUMB_TOLERANCE_M || offset >= last {
+            if offset <= self.settings.plumb_tolerance_m || offset >= last {
                 break;
             }
             last = offset;
@@ -539,9 +609,13 @@ impl TiedNets {
         if interior.is_empty() {
             return Ok(best);
         }
+        let (tolerance, steps) = (
+            self.settings.rear_level_tolerance,
+            self.settings.rear_level_steps,
+        );
         let mut previous: Option<(f64, f64)> = None;
-        for _ in 0..REAR_LEVEL_STEPS {
-            if f.abs() <= REAR_LEVEL_TOLERANCE {
+        for _ in 0..steps {
+            if f.abs() <= tolerance {
                 return Ok(best);
             }
             // The mean tension is nearly proportional to α: slope 1 first.
@@ -557,10 +631,10 @@ impl TiedNets {
             }
             (best, f) = (stage, next);
         }
-        if f.abs() > REAR_LEVEL_TOLERANCE {
+        if f.abs() > tolerance {
             best.warning = Some(format!(
                 "the rear net's mean tension is {} N, not the scene's {} N \
-                 (rear_net.mean_tension_n): its level did not converge in {REAR_LEVEL_STEPS} steps",
+                 (rear_net.mean_tension_n): its level did not converge in {steps} steps",
                 target * f.exp(),
                 target,
             ));
@@ -693,5 +767,60 @@ impl TiedNets {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defaults pass; a tolerance out of range or no pass of the stages
+    /// is refused by its dotted name.
+    #[test]
+    fn tied_net_settings_out_of_range_are_named() {
+        assert!(TiedNetSettings::default().validate().is_ok());
+        let cases = [
+            (
+                TiedNetSettings {
+                    selection_slack: -1e-3,
+                    ..TiedNetSettings::default()
+                },
+                "tied_nets.selection_slack",
+            ),
+            (
+                TiedNetSettings {
+                    weight_tolerance: f64::INFINITY,
+                    ..TiedNetSettings::default()
+                },
+                "tied_nets.weight_tolerance",
+            ),
+            (
+                TiedNetSettings {
+                    plumb_tolerance_m: f64::NAN,
+                    ..TiedNetSettings::default()
+                },
+                "tied_nets.plumb_tolerance_m",
+            ),
+            (
+                TiedNetSettings {
+                    rear_level_tolerance: -1.0,
+                    ..TiedNetSettings::default()
+                },
+                "tied_nets.rear_level_tolerance",
+            ),
+            (
+                TiedNetSettings {
+                    max_weight_passes: 0,
+                    ..TiedNetSettings::default()
+                },
+                "tied_nets.max_weight_passes",
+            ),
+        ];
+        for (settings, field) in cases {
+            match settings.validate() {
+                Err(DesignError::Setting { key, .. }) => assert_eq!(key, field),
+                other => panic!("{field}: {other:?}"),
+            }
+        }
     }
 }

@@ -6,8 +6,10 @@ use serde::Serialize;
 
 use super::assembly::State;
 use super::model::MechanicsError;
+use crate::status::{Status, Termination};
 
-/// How a static solve ended.
+/// How a static solve ended: the crate's shared reason ([`Status`]) with the
+/// load factor it reached.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "status", rename_all = "snake_case")]
 pub enum StaticTermination {
@@ -47,6 +49,22 @@ pub enum StaticTermination {
         /// Last converged load factor.
         load_factor: f64,
     },
+}
+
+impl Status for StaticTermination {
+    /// `LimitPoint` is [`Termination::Infeasible`] (no equilibrium at the
+    /// full load on the branch followed), `MaxSteps`
+    /// [`Termination::MaxIterations`], `Overflow`
+    /// [`Termination::NumericalError`]; the others their namesakes.
+    fn termination(&self) -> Termination {
+        match self {
+            StaticTermination::Converged => Termination::Converged,
+            StaticTermination::Stalled { .. } => Termination::Stalled,
+            StaticTermination::LimitPoint { .. } => Termination::Infeasible,
+            StaticTermination::MaxSteps { .. } => Termination::MaxIterations,
+            StaticTermination::Overflow { .. } => Termination::NumericalError,
+        }
+    }
 }
 
 impl std::fmt::Display for StaticTermination {
@@ -211,6 +229,48 @@ pub struct StaticSolution {
 impl StaticSolution {
     /// True at equilibrium under the full load.
     pub fn converged(&self) -> bool {
-        self.termination == StaticTermination::Converged
+        self.termination.converged()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every static ending reads as one shared reason, and only equilibrium
+    /// at the full load is `Converged`; the JSON keeps its `status` tag.
+    #[test]
+    fn static_terminations_read_as_the_shared_reasons() {
+        let cases = [
+            (StaticTermination::Converged, Termination::Converged),
+            (
+                StaticTermination::Stalled { load_factor: 0.5 },
+                Termination::Stalled,
+            ),
+            (
+                StaticTermination::LimitPoint {
+                    limit_load_factor: 0.6555,
+                },
+                Termination::Infeasible,
+            ),
+            (
+                StaticTermination::MaxSteps { load_factor: 0.9 },
+                Termination::MaxIterations,
+            ),
+            (
+                StaticTermination::Overflow { load_factor: 0.1 },
+                Termination::NumericalError,
+            ),
+        ];
+        for (ending, reason) in cases {
+            assert_eq!(ending.termination(), reason, "{ending}");
+            assert_eq!(ending.converged(), reason == Termination::Converged);
+        }
+        let json = serde_json::to_value(StaticTermination::LimitPoint {
+            limit_load_factor: 0.5,
+        })
+        .unwrap();
+        assert_eq!(json["status"], "limit_point");
+        assert_eq!(json["limit_load_factor"], 0.5);
     }
 }

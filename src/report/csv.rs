@@ -414,7 +414,7 @@ pub fn convergence_csv(runs: &[LoopRun]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::design::LoopTermination;
+    use crate::status::Termination;
 
     #[test]
     fn study_rows_read_back_as_written() {
@@ -430,7 +430,7 @@ mod tests {
             },
             time_s: 0.25,
             outer_iterations: Some(4),
-            termination: Some(LoopTermination::MaxIterations),
+            termination: Some(Termination::MaxIterations),
             boundary_residual_m: 2.5e-8,
             ratio: 1.25,
             built_ratio: 1.5,

@@ -48,6 +48,26 @@ pub enum ReportError {
         /// The cause.
         source: std::io::Error,
     },
+    /// A file a run's manifest names cannot be read
+    /// ([`check_manifest`](super::check_manifest)).
+    #[error("{file}: {source} (run {run})")]
+    ManifestUnreadable {
+        /// The file's name in the folder.
+        file: String,
+        /// The run whose manifest names it.
+        run: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A file is not the one a run's manifest records
+    /// ([`check_manifest`](super::check_manifest)).
+    #[error("{file} is not the file run {run} wrote: the folder mixes two runs")]
+    MixedRuns {
+        /// The file's name in the folder.
+        file: String,
+        /// The run whose manifest records it.
+        run: String,
+    },
     /// A value could not be serialised (a non-finite number in JSON, say).
     #[error("serialising {}: {source}", shown(path).display())]
     Json {

@@ -295,16 +295,21 @@ pub struct FileRecord {
 /// Checks that the files of `record` in `dir` are those the run wrote.
 ///
 /// # Errors
-/// The first file that is missing or differs, named.
-pub fn check_manifest(dir: &Path, record: &RunRecord) -> Result<(), String> {
+/// The first file that is missing ([`ReportError::ManifestUnreadable`]) or
+/// differs ([`ReportError::MixedRuns`]), named.
+pub fn check_manifest(dir: &Path, record: &RunRecord) -> Result<(), ReportError> {
     for file in &record.files {
-        let bytes = fs::read(dir.join(&file.name))
-            .map_err(|e| format!("{}: {e} (run {})", file.name, record.id))?;
+        let bytes =
+            fs::read(dir.join(&file.name)).map_err(|source| ReportError::ManifestUnreadable {
+                file: file.name.clone(),
+                run: record.id.clone(),
+                source,
+            })?;
         if bytes.len() != file.bytes || format!("{:016x}", fnv1a64(&bytes)) != file.fnv1a64 {
-            return Err(format!(
-                "{} is not the file run {} wrote: the folder mixes two runs",
-                file.name, record.id
-            ));
+            return Err(ReportError::MixedRuns {
+                file: file.name.clone(),
+                run: record.id.clone(),
+            });
         }
     }
     Ok(())
@@ -565,7 +570,12 @@ mod tests {
         assert!(svg.contains(&record.id), "{svg}");
         check_manifest(&dir, &record).unwrap();
         fs::write(dir.join("a.csv"), "x,y\n1,2\n").unwrap();
-        assert!(check_manifest(&dir, &record).unwrap_err().contains("a.csv"));
+        let mixed = check_manifest(&dir, &record).unwrap_err();
+        assert!(
+            matches!(&mixed, ReportError::MixedRuns { file, .. } if file == "a.csv"),
+            "{mixed}"
+        );
+        assert!(mixed.to_string().contains("a.csv"), "{mixed}");
     }
 
     #[test]

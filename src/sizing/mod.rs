@@ -35,13 +35,13 @@ use serde::Serialize;
 pub use catalogue::TubeSection;
 pub use error::SizingError;
 
-use crate::design::DesignError;
-use crate::design::{DesignRun, DesignSettings, LoopTermination};
+use crate::design::{DesignError, DesignRun, DesignSettings};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::LimitBound;
 #[cfg(doc)]
 use crate::mechanics::LimitSearch;
 use crate::scene::{Scene, TrussModel};
+use crate::status::Termination;
 use crate::truss::{TrussError, MARGIN_SEARCH_TO as SEARCH_TO};
 
 /// Where the sections come from.
@@ -70,7 +70,7 @@ pub struct SectionTrial {
     /// What bounds the limit load from above, when the margin was searched.
     pub bound: Option<LimitBound>,
     /// How the outer loop ended, when it ran to the end.
-    pub termination: Option<LoopTermination>,
+    pub termination: Option<Termination>,
     /// Outer iterations.
     pub outer_iterations: usize,
     /// Surface RMS of the design as built (assembled), mm.
@@ -232,7 +232,7 @@ impl Search<'_> {
                 trial.outer_iterations = report.outer_iterations;
                 trial.rms_mm = Some(report.verification.rms_mm);
                 trial.carries =
-                    report.termination == LoopTermination::Converged && trial.margin >= self.margin;
+                    report.termination == Termination::Converged && trial.margin >= self.margin;
                 run = Some(r);
             }
             Err(e) => match truss_failure(&e) {

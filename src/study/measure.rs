@@ -7,15 +7,16 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::{points, RunSettings, StudyError, StudyPoint, StudyRow, StudySettings};
-use crate::design::{LoopSettings, LoopTermination, SceneNets};
+use crate::design::{LoopSettings, SceneNets};
 use crate::scene::Scene;
 use crate::shard::Shard;
+use crate::status::Termination;
 use crate::verify::{verify, AssemblyTruss};
 
 /// What the outer loop made.
 struct LoopSummary {
     iterations: usize,
-    termination: LoopTermination,
+    termination: Termination,
     residual_m: f64,
     ratio: f64,
 }
@@ -209,7 +210,7 @@ pub fn run_study(
         message,
     };
     if let Some(s) = measured.summary.as_ref() {
-        if s.termination != LoopTermination::Converged {
+        if s.termination != Termination::Converged {
             return Err(failed(format!(
                 "its outer loop stopped {:?} after {} iterations (residual {:.3e} m): a \
                  yardstick must be converged",

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::{Knob, RunSettings};
-use crate::design::LoopTermination;
+use crate::status::Termination;
 
 /// One row of `accuracy-vs-time.csv`: a point, its cost and its accuracy.
 /// Missing numbers (a failed point, another net's cut lengths) are NaN.
@@ -21,7 +21,7 @@ pub struct StudyRow {
     /// Outer iterations.
     pub outer_iterations: Option<usize>,
     /// How the loop ended.
-    pub termination: Option<LoopTermination>,
+    pub termination: Option<Termination>,
     /// Final `‖G(C) − C‖∞`, m.
     pub boundary_residual_m: f64,
     /// The design's `Tmax/Tmin` (largest set).

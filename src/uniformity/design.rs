@@ -10,27 +10,11 @@ use std::time::Duration;
 use serde::Serialize;
 
 use super::{UniformityError, UniformityProblem};
+use crate::status::Termination;
 
 /// Relative miss of a set's mean tension within which a design holds its
 /// pretension level ([`Design::at_level`]).
 const LEVEL_TOLERANCE: f64 = 1e-9;
-
-/// How a solver stopped. Not converging is a status, not an error: a caller can
-/// never mistake it for a result.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Termination {
-    /// The solver's optimality test holds.
-    Converged,
-    /// The iteration limit was reached first.
-    MaxIterations,
-    /// No further progress was possible before the optimality test held.
-    Stalled,
-    /// No feasible `q` exists (for that solver's formulation).
-    Infeasible,
-    /// The inner solver reported a numerical failure.
-    NumericalError,
-}
 
 /// How the `lp` solver reached its design (reported with the design; every
 /// route but the first also leaves its reason in the warnings).
@@ -158,7 +142,8 @@ pub struct Design {
     pub surface_rms_m: f64,
     /// Largest surface error of the forward solve, m.
     pub surface_max_m: f64,
-    /// How the solver stopped.
+    /// How the solver stopped: `Converged`, `MaxIterations`, `Stalled`,
+    /// `Infeasible` or `NumericalError` (never `Diverged`).
     pub termination: Termination,
     /// Iterations of the solver (bisection steps, L-BFGS iterations plus
     /// the exact finish's programs, …).

@@ -16,7 +16,7 @@
 use std::time::Instant;
 
 use super::conic::{infeasible_design, Class, Cone, ConicProgram};
-use super::ipm::{self, IpmError, IpmSettings, IpmStatus};
+use super::ipm::{self, IpmError, IpmSettings};
 use super::plan::{CompletionError, PlanReduction};
 use super::{Design, Route, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
@@ -154,7 +154,7 @@ enum PlanFallback {
     Setup(#[from] IpmError),
     /// The interior-point method stopped short of its tolerance.
     #[error(
-        "the plan interior-point method stopped with {status:?} (relative primal residual \
+        "the plan interior-point method stopped with {termination:?} (relative primal residual \
          {:.1e}, dual {:.1e}, gap {:.1e})",
         .residuals[0],
         .residuals[1],
@@ -162,7 +162,7 @@ enum PlanFallback {
     )]
     Stopped {
         /// How it stopped.
-        status: IpmStatus,
+        termination: Termination,
         /// Relative primal residual, dual residual and gap.
         residuals: [f64; 3],
     },
@@ -180,15 +180,15 @@ fn solve_plan(
 ) -> Result<(Vec<f64>, usize), PlanFallback> {
     let solution = ipm::solve(plan.lp(), &IpmSettings::plan())?;
     let [primal, dual, gap] = solution.residuals;
-    match solution.status {
-        IpmStatus::Converged => {}
-        IpmStatus::ReducedAccuracy => warnings.push(format!(
+    match solution.termination {
+        Termination::Converged => {}
+        Termination::Stalled => warnings.push(format!(
             "lp: interior point stalled at reduced accuracy (relative primal residual \
              {primal:.1e}, dual {dual:.1e}, gap {gap:.1e})"
         )),
-        status => {
+        termination => {
             return Err(PlanFallback::Stopped {
-                status,
+                termination,
                 residuals: solution.residuals,
             })
         }

@@ -21,12 +21,14 @@ mod plan;
 mod problem;
 mod selection;
 
+/// How a solver stopped: the crate's shared vocabulary ([`crate::status`]).
+pub use crate::status::Termination;
 pub use bisection::Bisection;
-pub use design::{Design, Route, SlackNodes, TensionSpread, Termination};
+pub use design::{Design, Route, SlackNodes, TensionSpread};
 pub use front::{
     design_front, design_front_points, front_jobs, knob_values, FrontPoint, KnobRange,
 };
-pub use gradient::{Gradient, History};
+pub use gradient::{FinishSettings, Gradient, History};
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
 pub use problem::{SurfaceTarget, UniformityProblem, UniformitySet};

@@ -12,9 +12,9 @@ use argmin::core::{
 use argmin::solver::linesearch::MoreThuenteLineSearch;
 use argmin::solver::quasinewton::LBFGS;
 
+use super::history::History;
 use super::objective::Objective;
 use super::preconditioner::Preconditioner;
-use super::History;
 use crate::algebra::norm2;
 use crate::uniformity::{Termination, UniformityError};
 

@@ -119,10 +119,12 @@
 //! sparse LDLᵀ of the node graph in 6×6 blocks an iteration).
 
 mod finish;
+mod history;
 mod lbfgs;
 mod map;
 mod objective;
 mod preconditioner;
+mod settings;
 mod start;
 
 use std::time::Instant;
@@ -134,138 +136,13 @@ use objective::Objective;
 use preconditioner::Preconditioner;
 use start::{optimum_start, projected_start};
 
+pub use history::History;
+pub use settings::{FinishSettings, Gradient};
+
 /// Growth of the sharpness per restart.
 const SHARPNESS_GROWTH: f64 = 3.0;
 
-/// Adjoint-gradient L-BFGS on the free geometry (see the module documentation).
-#[derive(Debug, Clone)]
-pub struct Gradient {
-    /// Weight `w` of the ratio surrogate `ln(Tmax/Tmin)` against the surface
-    /// term `(RMS/ε)²`: larger buys a lower `Tmax/Tmin` with a larger surface
-    /// error (the design-front knob).
-    pub weight: f64,
-    /// Surface tolerance `ε`, m: the unit of the surface error and of the
-    /// layout drift.
-    pub surface_tolerance_m: f64,
-    /// Weight of the layout drift against the surface error (0: free layout).
-    pub layout_weight: f64,
-    /// Sharpness `β` of the soft max/min of `ln T`: larger follows `Tmax/Tmin`
-    /// more closely and makes the objective stiffer.
-    pub sharpness: f64,
-    /// Sharpness of the first L-BFGS run; it grows ×3 per restart up to
-    /// `sharpness` (continuation: smooth first, sharp at the end).
-    pub initial_sharpness: f64,
-    /// Weight `κ` of the pretension-level term `(ln(T̄₀/t₀)/10⁻³)²`.
-    pub level_weight: f64,
-    /// Weight `ν` of the bound barrier (its unit: 1 % beyond a bound).
-    pub barrier_weight: f64,
-    /// Number of correction pairs L-BFGS keeps.
-    pub memory: usize,
-    /// Most L-BFGS iterations in all.
-    pub max_iterations: usize,
-    /// Most iterations of one L-BFGS run; then the preconditioner is
-    /// re-linearised around the current point, the sharpness raised, and L-BFGS
-    /// restarted.
-    pub restart_iterations: usize,
-    /// Converged (at the final sharpness) when the stationarity
-    /// `‖dJ/dθ‖∞ / J` falls to this: scale-free, and independent of the start.
-    pub gradient_tolerance: f64,
-    /// Stop (at the final sharpness) when a whole L-BFGS run lowers `J` by no
-    /// more than `cost_tolerance · |J|`: `Converged` if the stationarity
-    /// holds, `Stalled` if it does not.
-    pub cost_tolerance: f64,
-    /// Precondition L-BFGS (see the module documentation); `false` runs it on `θ`.
-    pub precondition: bool,
-    /// Start from the uniform-tension guess projected onto equilibrium at the
-    /// design geometry; `false` starts from the network's `q`.
-    pub project_start: bool,
-    /// Start from the fixed-geometry optimum (`lp`'s design) where `lp`
-    /// applies (one set, no loads), before any other start.
-    pub optimum_start: bool,
-    /// After L-BFGS, sequential quadratic programs on the exact objective,
-    /// `ln(Tmax/Tmin)` in place of its soft form, to its stationarity (see
-    /// [`finish`]): the true minimiser for the weight, in a few programs
-    /// whatever the size, each far dearer than an L-BFGS iteration. From a
-    /// start near the optimum (`lp`'s, a neighbour's) or with
-    /// `max_iterations = 0` the programs start there, without L-BFGS. On by
-    /// default; off, the solver `gradient-smooth` ([`Gradient::smooth`]).
-    pub exact_finish: bool,
-}
-
-impl Default for Gradient {
-    fn default() -> Self {
-        Gradient {
-            weight: 1.0,
-            surface_tolerance_m: 1e-3,
-            layout_weight: 1.0,
-            sharpness: 1000.0,
-            initial_sharpness: 10.0,
-            level_weight: 1.0,
-            barrier_weight: 1.0,
-            memory: 20,
-            max_iterations: 5000,
-            restart_iterations: 300,
-            gradient_tolerance: 1e-3,
-            cost_tolerance: 1e-12,
-            precondition: true,
-            project_start: true,
-            optimum_start: true,
-            exact_finish: true,
-        }
-    }
-}
-
 impl Gradient {
-    /// The smoothed solve alone (the solver `gradient-smooth`): L-BFGS on the
-    /// soft max/min, without the exact finish.
-    pub fn smooth() -> Self {
-        Gradient {
-            exact_finish: false,
-            ..Gradient::default()
-        }
-    }
-
-    /// Checks the settings.
-    pub fn validate(&self) -> Result<(), UniformityError> {
-        let bad = |name: &'static str, value: f64, range: &'static str| {
-            Err(UniformityError::Setting {
-                solver: "gradient",
-                name,
-                value,
-                range,
-            })
-        };
-        let non_negative = [
-            ("weight", self.weight),
-            ("layout_weight", self.layout_weight),
-            ("barrier_weight", self.barrier_weight),
-            ("gradient_tolerance", self.gradient_tolerance),
-            ("cost_tolerance", self.cost_tolerance),
-        ];
-        for (what, v) in non_negative {
-            if !(v.is_finite() && v >= 0.0) {
-                return bad(what, v, "finite and ≥ 0");
-            }
-        }
-        for (what, v) in [
-            ("surface_tolerance_m", self.surface_tolerance_m),
-            ("sharpness", self.sharpness),
-            ("initial_sharpness", self.initial_sharpness),
-            ("level_weight", self.level_weight),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return bad(what, v, "finite and > 0");
-            }
-        }
-        if self.memory == 0 {
-            return bad("memory", 0.0, "≥ 1");
-        }
-        if self.restart_iterations == 0 {
-            return bad("restart_iterations", 0.0, "≥ 1");
-        }
-        Ok(())
-    }
-
     /// The objective `J(θ)` and its gradient `dJ/dθ` (adjoint, through the map).
     ///
     /// `theta`: n_edges.
@@ -462,7 +339,7 @@ impl Gradient {
             }
         }
         if self.exact_finish && termination != Termination::NumericalError {
-            let finished = finish::finish(&objective, &q)?;
+            let finished = finish::finish(&objective, &q, &self.finish)?;
             history.finish_steps = finished.steps;
             history.exact_objective = Some(finished.objective);
             warnings.extend(finished.warnings);
@@ -521,26 +398,6 @@ impl Gradient {
         design.termination = Termination::Stalled;
         Ok(design)
     }
-}
-
-/// Objective value and gradient norm of every accepted iterate.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct History {
-    /// The stationarity `‖dJ/dθ‖∞ / J` at the end (the convergence test).
-    pub stationarity: f64,
-    /// `J` at the start and after every iteration (each run at its own
-    /// sharpness, the start at the final one).
-    pub objective: Vec<f64>,
-    /// `‖dJ/dθ‖` at the same points.
-    pub gradient_norm: Vec<f64>,
-    /// Evaluations of `J` and its gradient (forward + adjoint solves).
-    pub evaluations: usize,
-    /// L-BFGS runs (the preconditioner is re-linearised for each).
-    pub runs: usize,
-    /// Quadratic programs of the exact finish (0 without it).
-    pub finish_steps: usize,
-    /// With the exact finish, `J` with the exact `ln(Tmax/Tmin)` at the end.
-    pub exact_objective: Option<f64>,
 }
 
 impl UniformitySolver for Gradient {

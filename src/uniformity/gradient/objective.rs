@@ -2,7 +2,7 @@
 //! documentation of [`super`]).
 
 use super::map::Map;
-use super::Gradient;
+use super::settings::Gradient;
 use crate::uniformity::{SurfaceTarget, UniformityError, UniformityProblem};
 
 /// Upper edge of the barrier's free box, as a fraction of `[q]`.

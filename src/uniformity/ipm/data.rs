@@ -3,7 +3,8 @@
 //! the lengths and the shifted lower bounds), with the settings it is solved
 //! with.
 
-use super::{IpmError, IpmSettings};
+use super::error::IpmError;
+use super::settings::IpmSettings;
 use crate::fdm::NONE;
 
 /// The data of the ratio LP in `D` coordinates per free node.

@@ -4,7 +4,8 @@
 //! of the unreduced system the regularised factor solves only inexactly.
 
 use super::data::Program;
-use super::normal::{NormalError, NormalMatrix};
+use super::error::NormalError;
+use super::normal::NormalMatrix;
 use crate::algebra::{dot, norm2};
 use crate::fdm::NONE;
 

@@ -3,11 +3,15 @@
 //! and its final projection onto equilibrium.
 
 use super::data::Program;
+use super::data::RatioLp;
 use super::direction::Rhs;
+use super::error::IpmError;
 use super::normal::NormalMatrix;
-use super::{IpmError, IpmSettings, IpmSolution, IpmStatus, RatioLp};
+use super::settings::IpmSettings;
+use super::status::IpmSolution;
 use crate::algebra::{dot, norm_inf};
 use crate::fdm::NONE;
+use crate::status::Termination;
 
 /// Solves the ratio LP with the structured interior-point method and
 /// `settings`. The returned `q` is unscaled (smallest set tension ≈ 1); the
@@ -90,7 +94,7 @@ impl Program {
                 return IpmSolution {
                     q: self.lower.clone(),
                     iterations: 0,
-                    status: IpmStatus::NumericalFailure,
+                    termination: Termination::NumericalError,
                     residuals: [f64::NAN; 3],
                 };
             };
@@ -283,10 +287,10 @@ impl Program {
             return IpmSolution {
                 q: x.iter().zip(&self.lower).map(|(a, l)| a + l).collect(),
                 iterations,
-                status: if failed {
-                    IpmStatus::NumericalFailure
+                termination: if failed {
+                    Termination::NumericalError
                 } else {
-                    IpmStatus::MaxIterations
+                    Termination::MaxIterations
                 },
                 residuals,
             };
@@ -298,12 +302,12 @@ impl Program {
         IpmSolution {
             q,
             iterations,
-            status: if primal > settings.polished {
-                IpmStatus::NumericalFailure
+            termination: if primal > settings.polished {
+                Termination::NumericalError
             } else if best.score <= 1.0 {
-                IpmStatus::Converged
+                Termination::Converged
             } else {
-                IpmStatus::ReducedAccuracy
+                Termination::Stalled
             },
             residuals,
         }

@@ -42,20 +42,21 @@
 //! The files follow Clarabel's `solver/core`: [`IpmSettings`] (`settings.rs`),
 //! the LP and its kernel form (`data.rs`), the normal system and its
 //! factorisation (`normal.rs`), the Newton direction with its FGMRES completion
-//! (`direction.rs`), the Mehrotra iteration (`driver.rs`), and what it returns
-//! (`status.rs`).
+//! (`direction.rs`), the Mehrotra iteration (`driver.rs`), what it returns
+//! (`status.rs`), and why it could not start (`error.rs`, below the others).
 
 mod data;
 mod direction;
 mod driver;
+mod error;
 mod normal;
 mod settings;
 mod status;
 
 pub(crate) use data::RatioLp;
 pub(crate) use driver::solve;
+pub(crate) use error::IpmError;
 pub(crate) use settings::IpmSettings;
-pub(crate) use status::{IpmError, IpmSolution, IpmStatus};
 
 #[cfg(test)]
 pub(crate) mod tests;

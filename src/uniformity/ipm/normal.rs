@@ -6,15 +6,16 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::linalg::solvers::LltError;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::{IpmSettings, RatioLp};
+use super::data::RatioLp;
+use super::error::NormalError;
+use super::settings::IpmSettings;
 use crate::algebra::norm_inf;
 use crate::fdm::NONE;
-use crate::uniformity::block_pattern::{BlockPattern, PatternError};
+use crate::uniformity::block_pattern::BlockPattern;
 
 /// The factorisation and the solves run on one thread: on super-100m's plan
 /// LP (84 362 net nodes, 31 iterations) the interior point took 8.0 s with
@@ -22,25 +23,6 @@ use crate::uniformity::block_pattern::{BlockPattern, PatternError};
 /// solve with one right-hand side is memory-bound, and the supernodes of a
 /// net's normal matrix are too small for the fork-join to pay.
 const PAR: Par = Par::Seq;
-
-/// Why the normal matrix could not be set up or factored.
-#[derive(Debug, thiserror::Error)]
-pub(crate) enum NormalError {
-    /// A workspace could not be allocated.
-    #[error("out of memory for {0}")]
-    OutOfMemory(&'static str),
-    /// The pattern, its ordering or its symbolic factorisation.
-    #[error(transparent)]
-    Pattern(#[from] PatternError),
-    /// The numeric factorisation failed even with the largest diagonal shift.
-    #[error("numeric factorisation with a diagonal shift of {shift:.1e}: {error:?}")]
-    Numeric {
-        /// The last shift tried.
-        shift: f64,
-        /// faer's error.
-        error: LltError,
-    },
-}
 
 /// The normal matrix `M = A Θ̃ Aᵀ` (lower triangle, D×D blocks per node pair),
 /// its symbolic factorisation, and the numeric factor of the current iteration.

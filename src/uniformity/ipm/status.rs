@@ -1,23 +1,8 @@
-//! What the interior-point method returns: how it stopped ([`IpmStatus`]),
-//! its last iterate ([`IpmSolution`]), and why it could not start
-//! ([`IpmError`]).
+//! What the interior-point method returns ([`IpmSolution`]): its last
+//! iterate and how it stopped, in the crate's shared vocabulary
+//! ([`Termination`]; why it could not start is `error.rs`'s).
 
-use super::normal::NormalError;
-
-/// How the interior-point method stopped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum IpmStatus {
-    /// Relative residuals and gap are below the tolerance.
-    Converged,
-    /// The iterate stopped improving with residuals and gap below
-    /// [`super::IpmSettings::reduced_tolerance`] (clarabel's `AlmostSolved`);
-    /// its best iterate.
-    ReducedAccuracy,
-    /// The iteration limit came first.
-    MaxIterations,
-    /// A factorisation failed or the iterate stopped being finite or interior.
-    NumericalFailure,
-}
+use crate::status::Termination;
 
 /// The outcome of [`super::solve`]: the last iterate, unscaled (the smallest
 /// set tension is ≈ 1), and how the method stopped.
@@ -27,35 +12,15 @@ pub(crate) struct IpmSolution {
     pub q: Vec<f64>,
     /// Interior-point iterations.
     pub iterations: usize,
-    /// How the method stopped.
-    pub status: IpmStatus,
+    /// How the method stopped:
+    /// * `Converged`: relative residuals and gap below the tolerance;
+    /// * `Stalled`: the iterate stopped improving with residuals and gap
+    ///   below [`super::IpmSettings::reduced_tolerance`] (clarabel's
+    ///   `AlmostSolved`): its best iterate, usable at reduced accuracy;
+    /// * `MaxIterations`: the iteration limit came first;
+    /// * `NumericalError`: a factorisation failed or the iterate stopped
+    ///   being finite or interior.
+    pub termination: Termination,
     /// Final relative primal residual, dual residual and gap.
     pub residuals: [f64; 3],
-}
-
-/// Why the interior-point method could not start.
-#[derive(Debug, thiserror::Error)]
-pub(crate) enum IpmError {
-    /// A setting is out of its range.
-    #[error("interior point: setting `{name}` = {value} must be {range}")]
-    Setting {
-        /// The field of [`super::IpmSettings`].
-        name: &'static str,
-        /// Its value.
-        value: f64,
-        /// The range it must be in.
-        range: &'static str,
-    },
-    /// The tension floor of the cables outside the set is not positive.
-    #[error("interior point: minimum tension fraction {value} must be > 0")]
-    MinTensionFraction {
-        /// The fraction given.
-        value: f64,
-    },
-    /// The uniformity set is empty.
-    #[error("interior point: the uniformity set has no cable")]
-    EmptySet,
-    /// The normal system could not be set up.
-    #[error("interior point: {0}")]
-    Normal(#[from] NormalError),
 }

@@ -2,6 +2,7 @@
 //! and the settings check.
 
 use super::*;
+use crate::status::Termination;
 use crate::uniformity::lp::solve_full;
 use crate::uniformity::UniformityProblem;
 
@@ -49,7 +50,7 @@ fn full_lp(problem: &UniformityProblem) -> RatioLp<3> {
 fn matches_clarabel(path: &str) {
     let problem = problem(path);
     let solution = solve(&full_lp(&problem), &IpmSettings::default()).expect("ipm");
-    assert_eq!(solution.status, IpmStatus::Converged);
+    assert_eq!(solution.termination, Termination::Converged);
     let lengths = problem.lengths_m();
     let set = &problem.sets()[0].edges;
     let tension = |k: usize| solution.q[k] * lengths[k];

@@ -17,7 +17,7 @@
 //! with `J` to `10⁻⁹ J` — or below [`COARSE`] times the decrease the
 //! program makes.
 
-use super::kkt::{Kkt, RowWeights};
+use super::kkt::{Kkt, KktError, RowWeights};
 use super::model::StepModel;
 use crate::algebra::norm_inf;
 
@@ -59,6 +59,27 @@ const WARM_FLOOR: f64 = 1e-4;
 /// Fraction of the step to the boundary taken.
 const STEP_FRACTION: f64 = 0.99;
 
+/// Why the interior point did not reach the program's optimum (the finish
+/// then asks clarabel).
+#[derive(Debug, thiserror::Error)]
+pub(super) enum ProgramError {
+    /// The reduced Newton system could not be set up, factored or solved.
+    #[error(transparent)]
+    Kkt(#[from] KktError),
+    /// The residuals or the gap stopped being finite numbers.
+    #[error("non-finite iterate at iteration {iteration}")]
+    NonFinite {
+        /// The interior-point iteration.
+        iteration: usize,
+    },
+    /// The iteration limit came first.
+    #[error("the step's program did not converge in {iterations} interior-point iterations")]
+    MaxIterations {
+        /// The limit, [`MAX_ITERATIONS`].
+        iterations: usize,
+    },
+}
+
 /// The program's optimum `z` and the multipliers `λ` of its rows, or why it
 /// was not reached. `warm`: the multipliers of the previous program of the
 /// same rows (the step before), the first `λ` where given; `coarse`: stop
@@ -68,9 +89,9 @@ pub(super) fn solve(
     model: &StepModel,
     warm: Option<&[f64]>,
     coarse: bool,
-) -> Result<(Vec<f64>, Vec<f64>), String> {
+) -> Result<(Vec<f64>, Vec<f64>), ProgramError> {
     let rows = Rows::new(model);
-    let mut kkt = Kkt::new(model).map_err(|e| e.0)?;
+    let mut kkt = Kkt::new(model)?;
     let n = model.n();
     let n_rows = rows.len();
     let n_eq = 3 * model.n_free;
@@ -120,7 +141,7 @@ pub(super) fn solve(
         let primal = norm_inf(&r_eq).max(norm_inf(&r_rows)) / h_norm;
         let dual = norm_inf(&r_dual) / c_norm;
         if !(primal.is_finite() && dual.is_finite() && gap.is_finite()) {
-            return Err(format!("non-finite iterate at iteration {iteration}"));
+            return Err(ProgramError::NonFinite { iteration });
         }
         let decrease = reference - f;
         let closed = gap <= TOLERANCE * f.abs().max(1.0) || gap <= COARSE * decrease;
@@ -134,7 +155,7 @@ pub(super) fn solve(
         let mu = gap / n_rows as f64;
 
         let weights = rows.weights(&s, &lambda);
-        kkt.factorize(&weights).map_err(|e| e.0)?;
+        kkt.factorize(&weights)?;
         let d: Vec<f64> = s.iter().zip(&lambda).map(|(s, l)| l / s).collect();
         // The Newton direction for the complementarity target `r_c`
         // (`s∘λ` minus what it should become).
@@ -156,7 +177,7 @@ pub(super) fn solve(
             let dl: Vec<f64> = (0..n_rows)
                 .map(|i| (-r_c[i] - lambda[i] * ds[i]) / s[i])
                 .collect();
-            Ok::<_, String>((dz, dy, ds, dl))
+            Ok::<_, KktError>((dz, dy, ds, dl))
         };
 
         // Predictor.
@@ -188,9 +209,9 @@ pub(super) fn solve(
             *v += alpha * d;
         }
     }
-    Err(format!(
-        "the step's program did not converge in {MAX_ITERATIONS} interior-point iterations"
-    ))
+    Err(ProgramError::MaxIterations {
+        iterations: MAX_ITERATIONS,
+    })
 }
 
 /// Adds to `model` the curvature its linearised `δ ln T_k = p_k + …` leaves
@@ -239,8 +260,8 @@ fn refined_solve(
     bz: &[f64],
     by: &[f64],
     max_steps: usize,
-) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let (mut dz, mut dy) = kkt.solve(bz, by).map_err(|e| e.0)?;
+) -> Result<(Vec<f64>, Vec<f64>), KktError> {
+    let (mut dz, mut dy) = kkt.solve(bz, by)?;
     // Each block's residual relative to the size of its own terms (a
     // backward error). A joint norm would hide the equilibrium's, and its
     // right-hand side is tiny near the optimum (zero at the start): it is
@@ -265,7 +286,7 @@ fn refined_solve(
             break;
         }
         previous = norm;
-        let (cz, cy) = kkt.solve(&rz, &ry).map_err(|e| e.0)?;
+        let (cz, cy) = kkt.solve(&rz, &ry)?;
         dz.iter_mut().zip(&cz).for_each(|(v, c)| *v += c);
         dy.iter_mut().zip(&cy).for_each(|(v, c)| *v += c);
     }

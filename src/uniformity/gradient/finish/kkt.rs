@@ -36,7 +36,7 @@
 //! against the exact operator.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
@@ -44,7 +44,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::model::StepModel;
 use crate::fdm::NONE;
-use crate::uniformity::block_pattern::BlockPattern;
+use crate::uniformity::block_pattern::{BlockPattern, PatternError};
 
 /// Unknowns per free node in the reduced system: `ξ` (3), then `y` (3).
 const B: usize = 6;
@@ -69,8 +69,25 @@ pub(super) struct RowWeights {
 }
 
 /// Why the reduced system could not be set up or factored.
-#[derive(Debug)]
-pub(super) struct KktError(pub(super) String);
+#[derive(Debug, thiserror::Error)]
+pub(super) enum KktError {
+    /// The pattern, its ordering or its symbolic factorisation.
+    #[error(transparent)]
+    Pattern(#[from] PatternError),
+    /// The factorisation's workspace could not be allocated.
+    #[error("out of memory for the factorisation")]
+    OutOfMemory,
+    /// The reduced system's values are not all finite.
+    #[error("the reduced system is not finite")]
+    NotFinite,
+    /// The numeric LDLᵀ factorisation failed.
+    #[error("numeric factorisation: {0:?}")]
+    Numeric(LdltError),
+    /// The Schur complement of the border (the sets' bound columns) is
+    /// singular.
+    #[error("the border's Schur complement is singular")]
+    SingularBorder,
+}
 
 /// The reduced Newton system of one step's program: pattern and symbolic
 /// factorisation (once per program), values and factor (per iteration).
@@ -113,13 +130,12 @@ impl<'a> Kkt<'a> {
             col_ptr,
             pattern,
             symbolic,
-        } = BlockPattern::new(&ends, n_free, B).map_err(|e| KktError(e.to_string()))?;
+        } = BlockPattern::new(&ends, n_free, B)?;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_ldlt_scratch::<f64>(PAR, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(2 * model.sets.len() + 2, PAR),
         ]);
-        let buffer = MemBuffer::try_new(req)
-            .map_err(|_| KktError("out of memory for the factorisation".into()))?;
+        let buffer = MemBuffer::try_new(req).map_err(|_| KktError::OutOfMemory)?;
         let m = model.m();
         Ok(Kkt {
             model,
@@ -224,7 +240,7 @@ impl<'a> Kkt<'a> {
         self.border_solved = solved;
         let schur = schur.lu();
         if !schur.is_invertible() {
-            return Err(KktError("the border's Schur complement is singular".into()));
+            return Err(KktError::SingularBorder);
         }
         self.schur = Some(schur);
         Ok(())
@@ -341,7 +357,7 @@ impl<'a> Kkt<'a> {
             values[col_ptr[j]] += STATIC_SHIFT * f64::from(self.signs[j]);
         }
         if values.iter().any(|v| !v.is_finite()) {
-            return Err(KktError("the reduced system is not finite".into()));
+            return Err(KktError::NotFinite);
         }
         self.symbolic
             .factorize_numeric_ldlt(
@@ -357,7 +373,7 @@ impl<'a> Kkt<'a> {
                 MemStack::new(&mut self.buffer),
                 Default::default(),
             )
-            .map_err(|e| KktError(format!("numeric factorisation: {e:?}")))?;
+            .map_err(KktError::Numeric)?;
         Ok(())
     }
 
@@ -459,7 +475,7 @@ impl<'a> Kkt<'a> {
             .schur
             .as_ref()
             .and_then(|lu| lu.solve(&rhs))
-            .ok_or_else(|| KktError("the border's Schur complement is singular".into()))?;
+            .ok_or(KktError::SingularBorder)?;
         for (column, &tj) in self.border_solved.iter().zip(t.iter()) {
             for (wi, ci) in w.iter_mut().zip(column) {
                 *wi -= ci * tj;

@@ -35,13 +35,13 @@
 //! tensions and was rejected (26 programs, J still 2e-3 above the end);
 //! with it the model predicts each decrease to 1 % and no step is refused
 //! (15 programs to the certificate, 6 with the reach of
-//! [`OUTSIDE_REACH`]; 4 on 10⁴ nodes, as before).
+//! [`FinishSettings::outside_reach`]; 4 on 10⁴ nodes, as before).
 //!
 //! The step is taken on `q` alone (the geometry follows by a forward solve)
 //! when `J_exact` falls by more than a tenth of the decrease the model
 //! predicts; the radius doubles (to at most ½) when the model predicts well
 //! and shrinks ×4 when it does not. The finish has converged when the model
-//! predicts a decrease of at most [`FINISH_TOLERANCE`]`·J`: no step of the
+//! predicts a decrease of at most [`FinishSettings::tolerance`]`·J`: no step of the
 //! linearised problem lowers `J_exact` further, a stationarity certificate of
 //! the nonsmooth problem that does not depend on the net's size.
 //!
@@ -50,66 +50,68 @@
 //! iterations of one sparse LDLᵀ of `6 n_free` unknowns each cold, 5–7 warm
 //! from the previous step's multipliers — 7–13× faster than clarabel on the
 //! program stated generically. clarabel remains the fallback, and the
-//! cross-check of the tests. Either solver's point is made feasible before
-//! its value is read ([`StepModel::feasible_point`]).
+//! cross-check of the tests; a program neither solves ([`ProgramFailed`])
+//! ends the finish as `Stalled`, with both reasons in a warning. Either
+//! solver's point is made feasible before its value is read
+//! ([`StepModel::feasible_point`]).
+//!
+//! The trust region and the stopping test are [`FinishSettings`]
+//! (`Gradient::finish`).
 
 mod ipm;
 mod kkt;
 mod model;
 
 use super::objective::{pretension_level, Objective};
+use super::settings::FinishSettings;
 use crate::fdm::{Equilibrium, NONE};
-use crate::uniformity::{SurfaceTarget, Termination, UniformityError};
-use model::{Cable, ErrorRow, StepModel};
+use crate::status::Termination;
+use crate::uniformity::{SurfaceTarget, UniformityError};
+use ipm::ProgramError;
+use model::{Cable, ClarabelFailed, ErrorRow, StepModel};
+
+/// Neither the interior point nor clarabel solved a step's program.
+#[derive(Debug, thiserror::Error)]
+#[error("interior point: {interior}; {clarabel}")]
+struct ProgramFailed {
+    /// Why the interior point stopped short.
+    interior: ProgramError,
+    /// Why clarabel did.
+    clarabel: ClarabelFailed,
+}
 
 /// The step's optimum `z` at a feasible point (see
 /// [`StepModel::feasible_point`]): the structured interior point
 /// (`ipm.rs`), warm from the previous step's `multipliers` and leaving its
 /// own there; clarabel where it fails (said in `warnings`).
+///
+/// # Errors
+/// Both failed: each one's reason.
 fn solve(
     model: &StepModel,
     eq: &Equilibrium,
     multipliers: &mut Option<Vec<f64>>,
     step: usize,
     warnings: &mut Vec<String>,
-) -> Option<Vec<f64>> {
+) -> Result<Vec<f64>, ProgramFailed> {
     let z = match ipm::solve(model, multipliers.as_deref(), true) {
         Ok((z, lambda)) => {
             *multipliers = Some(lambda);
             z
         }
-        Err(why) => {
-            warnings.push(format!(
-                "the exact finish's interior point failed at step {step} ({why}); clarabel \
-                 solved the program"
-            ));
-            model.solve_with_clarabel()?
-        }
+        Err(interior) => match model.solve_with_clarabel() {
+            Ok(z) => {
+                warnings.push(format!(
+                    "the exact finish's interior point failed at step {step} ({interior}); \
+                     clarabel solved the program"
+                ));
+                z
+            }
+            Err(clarabel) => return Err(ProgramFailed { interior, clarabel }),
+        },
     };
-    Some(model.feasible_point(&z, |rhs| eq.solve_d(rhs)))
+    Ok(model.feasible_point(&z, |rhs| eq.solve_d(rhs)))
 }
-
-/// The finish has converged when the model's predicted decrease is at most
-/// this times `J_exact`.
-pub(super) const FINISH_TOLERANCE: f64 = 1e-9;
-/// Most steps (quadratic programs) of the finish.
-pub(super) const MAX_FINISH_STEPS: usize = 50;
-/// The first trust radius, relative change of `q`.
-const FIRST_RADIUS: f64 = 0.05;
-/// The largest trust radius (`q` stays above half its value at a step).
-/// At 0.9 the 428-node net took 19 programs from the uniform-tension guess
-/// (against 11).
-const MAX_RADIUS: f64 = 0.5;
-/// A cable outside the sets may fall by this many times the trust radius
-/// a step, to at most [`MAX_FALL`]: the optimum slackens some (the ties of
-/// the tied nets), the model follows them well (they carry no ratio term),
-/// and halving them at most a step took the 38 876-node net 15 programs,
-/// the last nine spent so; with this reach, 6.
-const OUTSIDE_REACH: f64 = 4.0;
-/// The largest fall of a cable outside the sets in one step, relative.
-const MAX_FALL: f64 = 0.9;
-/// Below this radius a rejected step ends the finish.
-const MIN_RADIUS: f64 = 1e-9;
 
 /// What the finish returns.
 pub(super) struct Finished {
@@ -123,35 +125,46 @@ pub(super) struct Finished {
     pub(super) warnings: Vec<String>,
 }
 
-/// Sequential QP steps on `J_exact` from `q0` (see the module documentation).
-pub(super) fn finish(objective: &Objective, q0: &[f64]) -> Result<Finished, UniformityError> {
+/// Sequential QP steps on `J_exact` from `q0` with the trust region and the
+/// stopping test of `settings` (see the module documentation; checked by
+/// [`FinishSettings::validate`] with the solver's settings).
+pub(super) fn finish(
+    objective: &Objective,
+    q0: &[f64],
+    settings: &FinishSettings,
+) -> Result<Finished, UniformityError> {
     let exact = objective.exact();
     let mut q = q0.to_vec();
     let mut j = exact.evaluate_q(&q)?.0;
-    let mut radius = FIRST_RADIUS;
+    let mut radius = settings.first_radius;
     let mut warnings = Vec::new();
     let mut steps = 0;
     let mut multipliers = None;
     let termination = loop {
-        if steps == MAX_FINISH_STEPS {
+        if steps == settings.max_steps {
             warnings.push(format!(
-                "the exact finish did not converge in {MAX_FINISH_STEPS} steps"
+                "the exact finish did not converge in {} steps",
+                settings.max_steps
             ));
             break Termination::MaxIterations;
         }
         steps += 1;
-        let (mut model, eq) = step_model(objective, &q, radius)?;
+        let (mut model, eq) = step_model(objective, &q, radius, settings)?;
         if let Some(lambda) = multipliers.as_deref() {
             ipm::add_log_curvature(&mut model, lambda);
         }
-        let Some(z) = solve(&model, &eq, &mut multipliers, steps, &mut warnings) else {
-            warnings.push(format!(
-                "the exact finish stopped: its quadratic program failed at step {steps}"
-            ));
-            break Termination::Stalled;
+        let z = match solve(&model, &eq, &mut multipliers, steps, &mut warnings) {
+            Ok(z) => z,
+            Err(failed) => {
+                warnings.push(format!(
+                    "the exact finish stopped: its quadratic program failed at step {steps} \
+                     ({failed})"
+                ));
+                break Termination::Stalled;
+            }
         };
         let predicted = j - model.value(&z);
-        if predicted <= FINISH_TOLERANCE * j.abs() {
+        if predicted <= settings.tolerance * j.abs() {
             break Termination::Converged;
         }
         let trial: Vec<f64> = q
@@ -167,11 +180,11 @@ pub(super) fn finish(objective: &Objective, q0: &[f64]) -> Result<Finished, Unif
             q = trial;
             j = j_trial;
             if agreement > 0.75 {
-                radius = (2.0 * radius).min(MAX_RADIUS);
+                radius = (2.0 * radius).min(settings.max_radius);
             }
         } else {
             radius *= 0.25;
-            if radius < MIN_RADIUS {
+            if radius < settings.min_radius {
                 warnings.push(format!(
                     "the exact finish stopped: no step within the trust radius lowers J \
                      (the model predicts {predicted:.2e})"
@@ -189,11 +202,13 @@ pub(super) fn finish(objective: &Objective, q0: &[f64]) -> Result<Finished, Unif
     })
 }
 
-/// The quadratic model of `J_exact` about `q` with the trust radius `radius`.
+/// The quadratic model of `J_exact` about `q` with the trust radius `radius`
+/// (a cable outside the sets falling as far as `settings` lets it).
 fn step_model(
     objective: &Objective,
     q: &[f64],
     radius: f64,
+    settings: &FinishSettings,
 ) -> Result<(StepModel, Equilibrium), UniformityError> {
     let problem = objective.problem;
     let structure = problem.structure();
@@ -227,7 +242,7 @@ fn step_model(
             let fall = if in_set[k] {
                 reach
             } else {
-                (OUTSIDE_REACH * radius).min(MAX_FALL) * q[k]
+                (settings.outside_reach * radius).min(settings.max_fall) * q[k]
             };
             let lo = (objective.q_low[k] - q[k]).clamp(-fall, reach);
             let hi = (objective.q_high - q[k]).clamp(lo, reach);

@@ -9,6 +9,15 @@
 use crate::fdm::NONE;
 use crate::uniformity::conic::{Class, Cone, ConicProgram};
 
+/// clarabel did not solve a step's program.
+#[derive(Debug, thiserror::Error)]
+#[error("clarabel ended with status {status}")]
+pub(super) struct ClarabelFailed {
+    /// clarabel's status, verbatim (`NumericalError`, `PrimalInfeasible`,
+    /// `setup: …`).
+    pub(super) status: String,
+}
+
 /// One cable of the step: where it goes and the linearisation about `q`.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Cable {
@@ -319,8 +328,11 @@ impl StepModel {
 
     /// The model as a generic conic program for clarabel: the variables `z`,
     /// then one `ē` per error row and the level change `v`. Returns `z` at
-    /// the optimum, or `None` when clarabel fails.
-    pub(super) fn solve_with_clarabel(&self) -> Option<Vec<f64>> {
+    /// the optimum.
+    ///
+    /// # Errors
+    /// clarabel's status when it did not solve the program.
+    pub(super) fn solve_with_clarabel(&self) -> Result<Vec<f64>, ClarabelFailed> {
         let n = self.n();
         let at_xi = self.at_xi();
         let at_e = n;
@@ -400,6 +412,12 @@ impl StepModel {
             program.row(Cone::Nonnegative, &[(k, 1.0)], cable.hi);
         }
         let outcome = program.solve_quadratic(&p, &c);
-        (outcome.class == Class::Feasible).then(|| outcome.x[..n].to_vec())
+        if outcome.class == Class::Feasible {
+            Ok(outcome.x[..n].to_vec())
+        } else {
+            Err(ClarabelFailed {
+                status: outcome.status,
+            })
+        }
     }
 }

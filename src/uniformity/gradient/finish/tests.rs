@@ -34,7 +34,8 @@ fn the_interior_point_and_clarabel_agree_on_the_step_programs() {
             };
             let objective = Objective::new(&settings, &problem);
             for radius in [0.01, 0.5] {
-                let (model, eq) = step_model(&objective, &q, radius).expect("model");
+                let (model, eq) =
+                    step_model(&objective, &q, radius, &FinishSettings::default()).expect("model");
                 let feasible = |z: &[f64]| model.feasible_point(z, |rhs| eq.solve_d(rhs));
                 let ours = feasible(&ipm::solve(&model, None, false).expect("interior point").0);
                 let theirs = feasible(&model.solve_with_clarabel().expect("clarabel"));
@@ -67,4 +68,44 @@ fn the_interior_point_and_clarabel_agree_on_the_step_programs() {
             }
         }
     }
+}
+
+/// The finish's budget is its settings': from `lp`'s optimum shifted by ±3 %
+/// per cable on small-hex, one program cannot reach the certificate and
+/// says so; the default budget does.
+#[test]
+fn the_finish_stops_at_its_step_budget_and_converges_within_the_default() {
+    let problem = problem("problems/small-hex.toml");
+    let lp = Lp.solve(&problem).expect("lp");
+    let shift = pattern(lp.q.len(), 3);
+    let q: Vec<f64> =
+        lp.q.iter()
+            .zip(&shift)
+            .map(|(q, s)| q * (1.0 + 0.03 * s))
+            .collect();
+    let gradient = Gradient::default();
+    let objective = Objective::new(&gradient, &problem);
+    let one = FinishSettings {
+        max_steps: 1,
+        ..FinishSettings::default()
+    };
+    let short = finish(&objective, &q, &one).expect("finish");
+    assert_eq!(short.termination, Termination::MaxIterations);
+    assert_eq!(short.steps, 1);
+    assert!(
+        short
+            .warnings
+            .iter()
+            .any(|w| w.contains("did not converge in 1 steps")),
+        "{:?}",
+        short.warnings
+    );
+    let full = finish(&objective, &q, &FinishSettings::default()).expect("finish");
+    assert_eq!(
+        full.termination,
+        Termination::Converged,
+        "{:?}",
+        full.warnings
+    );
+    assert!(full.steps > 1 && full.objective < short.objective);
 }
