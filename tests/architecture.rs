@@ -1,10 +1,16 @@
-//! The crate's structure (docs/ARCHITECTURE.md): no import cycles, between
-//! the top-level modules or between the files of one module. A file's
-//! dependencies are read from its `crate::…` and `super::…` paths, items
-//! re-exported by a `mod.rs` followed to the file that defines them; the
-//! crate root (`lib.rs`, which joins every module's error), the edges
-//! between a `mod.rs` and the files below it (declarations, re-exports) and
-//! unit tests (which may use any layer) are left out.
+//! The crate's structure (docs/ARCHITECTURE.md): no import cycles, counted
+//! file to file. A file's dependencies are the items its code names —
+//! `use` items, inline `crate::`/`super::`/`self::` paths, and in a `mod.rs`
+//! or `lib.rs` paths through its own child modules (`sizing::SizingError`) —
+//! each followed through the re-exports (`pub use`, `pub(crate) use`,
+//! `pub(super) use`) to the file that defines it. A re-export is not itself
+//! a dependency; everything else counts, a `mod.rs` and the crate root
+//! (`lib.rs`) included: a `mod.rs` whose own code uses a child file that uses
+//! an item defined in that `mod.rs` is a cycle. Unit tests (which may use any
+//! layer) are left out.
+//!
+//! The analysis runs on the crate and, to show that it sees each kind of
+//! cycle the project has had, on small synthetic trees that reintroduce them.
 
 mod common;
 
@@ -23,9 +29,10 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The module path of a file: `src/a/b.rs` → `a::b`, `src/a/mod.rs` → `a`.
-fn module_of(path: &Path) -> Vec<String> {
-    let rel = path.strip_prefix(common::source_dir()).unwrap();
+/// The module path of a file under `root`: `a/b.rs` → `a::b`, `a/mod.rs` → `a`,
+/// `lib.rs` → the root (empty path).
+fn module_of(root: &Path, path: &Path) -> Vec<String> {
+    let rel = path.strip_prefix(root).unwrap();
     let mut parts: Vec<String> = rel
         .iter()
         .map(|p| p.to_string_lossy().trim_end_matches(".rs").to_string())
@@ -79,110 +86,143 @@ fn expand(path: &str) -> Vec<String> {
         .collect()
 }
 
-/// Every path of a file's `use` items and inline `crate::`/`super::` paths,
-/// made absolute (segments from the crate root), `as` renames dropped.
-fn paths_of(module: &[String], is_root: bool, code: &str) -> Vec<Vec<String>> {
-    let mut raw = Vec::new();
-    let mut rest = code;
-    while let Some(i) = rest.find("use ") {
-        let boundary = i == 0 || !rest.as_bytes()[i - 1].is_ascii_alphanumeric();
-        let after = &rest[i + 4..];
-        let end = after.find(';').unwrap_or(after.len());
-        if boundary {
-            raw.extend(expand(&after[..end]));
-        }
-        rest = &after[end.min(after.len())..];
-    }
-    for key in ["crate::", "super::"] {
-        let mut rest = code;
-        while let Some(i) = rest.find(key) {
-            let tail = &rest[i..];
-            let end = tail
-                .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
-                .unwrap_or(tail.len());
-            raw.push(tail[..end].trim_end_matches(':').to_string());
-            rest = &tail[end..];
-        }
-    }
-    // `super` of a file is its parent module; of a mod.rs, the grandparent.
-    let parent: Vec<String> = if is_root {
-        module[..module.len().saturating_sub(1)].to_vec()
-    } else {
-        module[..module.len() - 1].to_vec()
-    };
-    raw.into_iter()
-        .filter_map(|p| {
-            let p = p.split(" as ").next().unwrap().to_string();
-            let segments: Vec<String> = p.split("::").map(str::to_string).collect();
-            match segments.first().map(String::as_str) {
-                Some("crate") => Some(segments[1..].to_vec()),
-                Some("super") => {
-                    let mut base = parent.clone();
-                    let mut s = &segments[1..];
-                    while s.first().is_some_and(|x| x == "super") {
-                        base.pop();
-                        s = &s[1..];
-                    }
-                    base.extend(s.iter().cloned());
-                    Some(base)
-                }
-                _ => None,
-            }
-        })
-        .collect()
+/// A file's `use` items, split into re-exports (`pub use`, `pub(crate) use`,
+/// `pub(super) use`, `pub(in …) use`) and private imports, each as its
+/// expanded paths (`as` renames dropped, a trailing `self` dropped); and the
+/// code with every `use` item blanked out.
+struct Imports {
+    exports: Vec<String>,
+    imports: Vec<String>,
+    rest: String,
 }
 
+fn imports_of(code: &str) -> Imports {
+    let (mut exports, mut imports, mut rest) = (Vec::new(), Vec::new(), String::new());
+    let mut text = code;
+    while let Some(i) = text.find("use ") {
+        let boundary = i == 0 || !text.as_bytes()[i - 1].is_ascii_alphanumeric();
+        let after = &text[i + 4..];
+        let end = after.find(';').unwrap_or(after.len());
+        if !boundary {
+            rest.push_str(&text[..i + 4]);
+            text = after;
+            continue;
+        }
+        let before = text[..i].trim_end();
+        let visibility = before
+            .rfind([';', '}', '{', ']'])
+            .map_or(before, |k| &before[k + 1..])
+            .trim();
+        let paths = expand(&after[..end]).into_iter().map(|p| {
+            let p = p.split(" as ").next().unwrap().to_string();
+            p.strip_suffix("::self").map(str::to_string).unwrap_or(p)
+        });
+        if visibility.starts_with("pub") {
+            exports.extend(paths);
+        } else {
+            imports.extend(paths);
+        }
+        rest.push_str(&text[..i]);
+        text = &after[end.min(after.len())..];
+    }
+    rest.push_str(text);
+    Imports {
+        exports,
+        imports,
+        rest,
+    }
+}
+
+/// Every occurrence of `prefix::a::b…` in `code` (not preceded by an
+/// identifier character or `::`), as the text from `prefix`.
+fn inline_paths(code: &str, prefix: &str) -> Vec<String> {
+    let key = format!("{prefix}::");
+    let mut found = Vec::new();
+    let mut start = 0;
+    while let Some(i) = code[start..].find(&key) {
+        let at = start + i;
+        let before = code[..at].chars().next_back();
+        let free = !before.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':');
+        let tail = &code[at..];
+        let end = tail
+            .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+            .unwrap_or(tail.len());
+        if free {
+            found.push(tail[..end].trim_end_matches(':').to_string());
+        }
+        start = at + end.max(key.len());
+    }
+    found
+}
+
+/// Module paths → defining files, re-exports, and each file's uses.
 struct Crate {
     /// Module path → file.
     files: BTreeMap<Vec<String>, PathBuf>,
-    /// (module, item) → the absolute path a `pub use` in that module names.
+    /// (module, item) → the absolute path a re-export in that module names.
     exports: BTreeMap<(Vec<String>, String), Vec<String>>,
-    /// File → absolute paths it uses.
+    /// File → absolute paths its code names.
     uses: BTreeMap<PathBuf, Vec<Vec<String>>>,
 }
 
 impl Crate {
     fn read() -> Crate {
+        Crate::read_tree(&common::source_dir())
+    }
+
+    /// The crate whose root (`lib.rs`) is in `root`; the binary (`main.rs`)
+    /// and unit-test files (`tests.rs`) are left out.
+    fn read_tree(root: &Path) -> Crate {
         let mut paths = Vec::new();
-        rust_files(&common::source_dir(), &mut paths);
-        let mut files = BTreeMap::new();
+        rust_files(root, &mut paths);
+        paths.retain(|p| !(p.ends_with("main.rs") || p.ends_with("tests.rs")));
+        let files: BTreeMap<Vec<String>, PathBuf> = paths
+            .iter()
+            .map(|p| (module_of(root, p), p.clone()))
+            .collect();
         let mut exports = BTreeMap::new();
         let mut uses = BTreeMap::new();
-        for path in paths {
-            // The binary, and unit-test modules kept in a file of their own.
-            if path.ends_with("main.rs") || path.ends_with("tests.rs") {
-                continue;
-            }
-            let module = module_of(&path);
-            let is_root = path.ends_with("mod.rs") || path.ends_with("lib.rs");
-            let text = code(&std::fs::read_to_string(&path).unwrap());
-            // Re-exports, relative paths made absolute.
-            for line in text.split(';') {
-                let Some(i) = line.find("pub use ") else {
-                    continue;
-                };
-                for p in expand(&line[i + 8..]) {
-                    let p = p.split(" as ").next().unwrap().to_string();
-                    let segments: Vec<String> = p.split("::").map(str::to_string).collect();
-                    let absolute = match segments[0].as_str() {
-                        "crate" => segments[1..].to_vec(),
-                        "super" => {
-                            let mut b = module[..module.len() - 1].to_vec();
-                            b.extend(segments[1..].iter().cloned());
-                            b
-                        }
-                        _ => {
-                            let mut b = module.clone();
-                            b.extend(segments.iter().cloned());
-                            b
-                        }
-                    };
-                    let name = absolute.last().unwrap().clone();
-                    exports.insert((module.clone(), name), absolute);
+        for path in &paths {
+            let module = module_of(root, path);
+            let children: BTreeSet<String> = files
+                .keys()
+                .filter(|m| m.len() == module.len() + 1 && m.starts_with(&module))
+                .map(|m| m.last().unwrap().clone())
+                .collect();
+            let absolute = |p: &str| absolute(&module, &children, p);
+            let imports = imports_of(&code(&std::fs::read_to_string(path).unwrap()));
+            for p in &imports.exports {
+                if let Some(target) = absolute(p) {
+                    let name = p.rsplit("::").next().unwrap().to_string();
+                    exports.insert((module.clone(), name), target);
                 }
             }
-            uses.insert(path.clone(), paths_of(&module, is_root, &text));
-            files.insert(module, path);
+            let mut named: Vec<Vec<String>> = Vec::new();
+            let mut aliases = Vec::new();
+            for p in &imports.imports {
+                let Some(target) = absolute(p) else { continue };
+                if files.contains_key(&target) {
+                    // A module imported by name: its items are named through it.
+                    aliases.push((p.rsplit("::").next().unwrap().to_string(), target));
+                } else {
+                    named.push(target);
+                }
+            }
+            let mut prefixes = vec!["crate".to_string(), "super".to_string(), "self".to_string()];
+            prefixes.extend(children.iter().cloned());
+            for prefix in &prefixes {
+                for p in inline_paths(&imports.rest, prefix) {
+                    named.extend(absolute(&p));
+                }
+            }
+            for (alias, target) in &aliases {
+                for p in inline_paths(&imports.rest, alias) {
+                    let mut full = target.clone();
+                    full.extend(p.split("::").skip(1).map(str::to_string));
+                    named.push(full);
+                }
+            }
+            uses.insert(path.clone(), named);
         }
         Crate {
             files,
@@ -191,7 +231,8 @@ impl Crate {
         }
     }
 
-    /// The file that defines what `path` names.
+    /// The file that defines what `path` names: the longest module prefix,
+    /// followed through that module's re-export of the next segment.
     fn resolve(&self, path: &[String], depth: usize) -> Option<PathBuf> {
         let mut k = path.len();
         while k > 0 && !self.files.contains_key(&path[..k]) {
@@ -210,26 +251,47 @@ impl Crate {
         self.files.get(&module).cloned()
     }
 
-    /// File → files it depends on (parent–child edges and the root left out).
+    /// File → the files whose items it names.
     fn graph(&self) -> BTreeMap<PathBuf, BTreeSet<PathBuf>> {
-        let module_of_file: BTreeMap<&PathBuf, &Vec<String>> =
-            self.files.iter().map(|(m, f)| (f, m)).collect();
         let mut graph = BTreeMap::new();
         for (file, paths) in &self.uses {
-            let from = module_of_file[file];
             let edges: &mut BTreeSet<PathBuf> = graph.entry(file.clone()).or_default();
             for p in paths {
-                let Some(target) = self.resolve(p, 0) else {
+                // A path that only names a module (`crate::truss`) names no item.
+                if self.files.contains_key(p) {
                     continue;
-                };
-                let to = module_of_file[&target];
-                let related = from.starts_with(to) || to.starts_with(from);
-                if target != *file && !to.is_empty() && !related {
-                    edges.insert(target);
+                }
+                if let Some(target) = self.resolve(p, 0) {
+                    if target != *file {
+                        edges.insert(target);
+                    }
                 }
             }
         }
         graph
+    }
+}
+
+/// `p` as a path from the crate root, for a file of module `module` whose
+/// child modules are `children`; `None` for a path outside the crate. (A
+/// file's `super` is its module's parent, whether it is `a/b.rs` or
+/// `a/b/mod.rs`.)
+fn absolute(module: &[String], children: &BTreeSet<String>, p: &str) -> Option<Vec<String>> {
+    let segments: Vec<String> = p.split("::").map(str::to_string).collect();
+    match segments.first().map(String::as_str) {
+        Some("crate") => Some(segments[1..].to_vec()),
+        Some("self") => Some([module, &segments[1..]].concat()),
+        Some("super") => {
+            let mut base = module.to_vec();
+            let mut s = segments.as_slice();
+            while s.first().is_some_and(|x| x == "super") {
+                base.pop();
+                s = &s[1..];
+            }
+            Some([base.as_slice(), s].concat())
+        }
+        Some(first) if children.contains(first) => Some([module, segments.as_slice()].concat()),
+        _ => None,
     }
 }
 
@@ -267,6 +329,18 @@ fn cycles<T: Ord + Clone>(graph: &BTreeMap<T, BTreeSet<T>>) -> Vec<Vec<T>> {
     found
 }
 
+/// The file cycles of the crate in `root`, each as paths relative to it.
+fn file_cycles(root: &Path) -> Vec<Vec<String>> {
+    cycles(&Crate::read_tree(root).graph())
+        .into_iter()
+        .map(|c| {
+            c.iter()
+                .map(|p| p.strip_prefix(root).unwrap().display().to_string())
+                .collect()
+        })
+        .collect()
+}
+
 #[test]
 fn no_two_files_import_each_other_even_through_others() {
     let krate = Crate::read();
@@ -278,14 +352,17 @@ fn no_two_files_import_each_other_even_through_others() {
 
 #[test]
 fn no_two_top_level_modules_import_each_other() {
+    let root = common::source_dir();
     let krate = Crate::read();
     let mut modules: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for (file, targets) in krate.graph() {
-        let from = module_of(&file);
+        let from = module_of(&root, &file);
         let Some(top) = from.first() else { continue };
         let entry = modules.entry(top.clone()).or_default();
         for t in targets {
-            let to = module_of(&t)[0].clone();
+            let Some(to) = module_of(&root, &t).first().cloned() else {
+                continue;
+            };
             if to != *top {
                 entry.insert(to);
             }
@@ -300,6 +377,25 @@ fn no_two_top_level_modules_import_each_other() {
     );
 }
 
+/// Only the crate root and the command layer name `crate::Error`: every
+/// other module returns its own error.
+#[test]
+fn only_the_command_layer_returns_the_crate_error() {
+    let root = common::source_dir();
+    let krate = Crate::read();
+    let lib = root.join("lib.rs");
+    let users: Vec<String> = krate
+        .graph()
+        .into_iter()
+        .filter(|(file, targets)| targets.contains(&lib) && !file.starts_with(root.join("run")))
+        .map(|(file, _)| file.strip_prefix(&root).unwrap().display().to_string())
+        .collect();
+    assert!(
+        users.is_empty(),
+        "files below run/ that use lib.rs: {users:?}"
+    );
+}
+
 /// The reader: the dependency analysis sees through a `mod.rs` re-export.
 #[test]
 fn a_re_exported_item_resolves_to_its_defining_file() {
@@ -308,5 +404,177 @@ fn a_re_exported_item_resolves_to_its_defining_file() {
     assert_eq!(
         krate.resolve(&path, 0),
         Some(common::source_dir().join("design/tied_nets.rs"))
+    );
+}
+
+/// A synthetic crate: `(path under src/, code)` pairs written to a fresh
+/// folder.
+fn tree(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let root = std::env::temp_dir().join(format!(
+        "ringmesh-architecture-{name}-{}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&root);
+    for (path, text) in files {
+        let path = root.join(path);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, text).unwrap();
+    }
+    root
+}
+
+/// Asserts that the crate in `root` has exactly one cycle, through `files`.
+fn assert_one_cycle(root: &Path, files: &[&str]) {
+    let found = file_cycles(root);
+    let _ = std::fs::remove_dir_all(root);
+    let mut expected: Vec<String> = files.iter().map(|f| f.to_string()).collect();
+    expected.sort();
+    assert_eq!(found, vec![expected]);
+}
+
+/// `report/mod.rs ↔ report/output_set.rs`: a `mod.rs` whose code calls a
+/// child that uses the error the `mod.rs` defines.
+#[test]
+fn the_guard_sees_a_mod_rs_and_its_child_using_each_other() {
+    let root = tree(
+        "mod-child",
+        &[
+            ("lib.rs", "pub mod report;\n"),
+            (
+                "report/mod.rs",
+                "mod output_set;\npub use output_set::OutputSet;\n\
+                 pub enum ReportError { Io }\n\
+                 pub fn shown() -> String { output_set::name() }\n",
+            ),
+            (
+                "report/output_set.rs",
+                "use super::ReportError;\npub struct OutputSet;\n\
+                 pub fn name() -> String { String::new() }\n\
+                 pub fn fail() -> ReportError { ReportError::Io }\n",
+            ),
+        ],
+    );
+    assert_one_cycle(&root, &["report/mod.rs", "report/output_set.rs"]);
+}
+
+/// The same child, with the error moved down into a base file, is no cycle:
+/// the guard does not count a re-export as a use.
+#[test]
+fn the_guard_does_not_count_re_exports() {
+    let root = tree(
+        "re-export",
+        &[
+            ("lib.rs", "pub mod report;\n"),
+            (
+                "report/mod.rs",
+                "mod error;\nmod output_set;\npub use error::ReportError;\n\
+                 pub use output_set::OutputSet;\n",
+            ),
+            ("report/error.rs", "pub enum ReportError { Io }\n"),
+            (
+                "report/output_set.rs",
+                "use super::ReportError;\npub struct OutputSet;\n\
+                 pub fn fail() -> ReportError { ReportError::Io }\n",
+            ),
+        ],
+    );
+    let found = file_cycles(&root);
+    let _ = std::fs::remove_dir_all(&root);
+    assert!(found.is_empty(), "{found:?}");
+}
+
+/// `lib.rs ↔ sizing/catalogue.rs ↔ sizing/mod.rs`: the crate's error joins a
+/// module's error, and that module returns the crate's error.
+#[test]
+fn the_guard_sees_a_module_returning_the_crate_error() {
+    let root = tree(
+        "crate-error",
+        &[
+            (
+                "lib.rs",
+                "pub mod sizing;\n\
+                 pub enum Error { Sizing(sizing::SizingError) }\n",
+            ),
+            (
+                "sizing/mod.rs",
+                "mod catalogue;\npub use catalogue::Section;\n\
+                 pub enum SizingError { Empty }\n\
+                 pub fn size() -> Result<catalogue::Section, crate::Error> { catalogue::read() }\n",
+            ),
+            (
+                "sizing/catalogue.rs",
+                "use crate::Error;\npub struct Section;\n\
+                 pub fn read() -> Result<Section, Error> { Ok(Section) }\n",
+            ),
+        ],
+    );
+    // catalogue.rs → lib.rs → sizing/mod.rs → catalogue.rs, and lib.rs.
+    assert_one_cycle(&root, &["lib.rs", "sizing/catalogue.rs", "sizing/mod.rs"]);
+}
+
+/// `ipm/status.rs → normal.rs → data.rs → status.rs`, through `pub(crate)
+/// use` re-exports of the module.
+#[test]
+fn the_guard_follows_crate_visible_re_exports() {
+    let root = tree(
+        "crate-visible",
+        &[
+            ("lib.rs", "pub mod ipm;\n"),
+            (
+                "ipm/mod.rs",
+                "mod data;\nmod normal;\nmod status;\n\
+                 pub(crate) use data::Data;\npub(super) use normal::Normal;\n\
+                 pub use status::Status;\n",
+            ),
+            (
+                "ipm/status.rs",
+                "use super::Normal;\npub struct Status(Normal);\n",
+            ),
+            (
+                "ipm/normal.rs",
+                "use super::Data;\npub struct Normal(Data);\n",
+            ),
+            ("ipm/data.rs", "pub struct Data(crate::ipm::Status);\n"),
+        ],
+    );
+    assert_one_cycle(&root, &["ipm/data.rs", "ipm/normal.rs", "ipm/status.rs"]);
+}
+
+/// `gradient/finish ↔ lbfgs ↔ mod ↔ objective`: a module imported by name
+/// (`use super::objective;`) and used through it.
+#[test]
+fn the_guard_follows_a_module_imported_by_name() {
+    let root = tree(
+        "by-name",
+        &[
+            ("lib.rs", "pub mod gradient;\n"),
+            (
+                "gradient/mod.rs",
+                "mod finish;\nmod lbfgs;\nmod objective;\n\
+                 pub struct Gradient;\n\
+                 pub fn solve() { finish::run() }\n",
+            ),
+            (
+                "gradient/finish/mod.rs",
+                "use super::lbfgs;\npub fn run() { lbfgs::minimise() }\n",
+            ),
+            (
+                "gradient/lbfgs.rs",
+                "use super::objective;\npub fn minimise() { objective::value(); }\n",
+            ),
+            (
+                "gradient/objective.rs",
+                "pub fn value() -> super::Gradient { super::Gradient }\n",
+            ),
+        ],
+    );
+    assert_one_cycle(
+        &root,
+        &[
+            "gradient/finish/mod.rs",
+            "gradient/lbfgs.rs",
+            "gradient/mod.rs",
+            "gradient/objective.rs",
+        ],
     );
 }
