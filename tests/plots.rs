@@ -64,7 +64,7 @@ fn every_plot_is_drawn_for_every_shipped_scene() {
         let name = scene.display();
 
         // The front: a solver without a knob (one point) and one with.
-        let (front, _) = run::front(
+        let front = run::front(
             &scene,
             &[SolverKind::Lp, SolverKind::LeastSquares],
             3,
@@ -73,7 +73,7 @@ fn every_plot_is_drawn_for_every_shipped_scene() {
             &Silent,
         )
         .unwrap_or_else(|e| panic!("{name}: front: {e}"));
-        assert_eq!(front.len(), 4, "{name}");
+        assert_eq!(front.points.len(), 4, "{name}");
         assert_drawn(out.path(), "front", &scene);
 
         // The study: the rigid-truss design judged against the reference.

@@ -3,9 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::report::{aperture_csv, aperture_plot, write_atomic, write_json, OutputSet};
+use super::Summary;
+use crate::report::{aperture_csv, aperture_plot, readable, write_atomic, write_json, OutputSet};
 use crate::scene::Scene;
-use crate::study::{run_aperture_study, ApertureResult, ApertureSettings};
+use crate::study::{run_aperture_study, value_name, ApertureResult, ApertureSettings};
 use crate::Error;
 
 /// What `ringmesh apertures` made.
@@ -15,6 +16,49 @@ pub struct AperturesOutcome {
     pub results: Vec<ApertureResult>,
     /// Files written.
     pub written: Vec<PathBuf>,
+}
+
+impl AperturesOutcome {
+    /// What `ringmesh apertures` prints: one line per aperture
+    /// ([`aperture_line`]), the files written.
+    pub fn summary(&self) -> Summary {
+        let mut s = Summary::default();
+        for r in &self.results {
+            say!(s, "{}", aperture_line(r));
+        }
+        s.written(&self.written);
+        s
+    }
+}
+
+/// One aperture of the aperture study, on one line: its net, its sized
+/// tube, and each design model's RMS and tension change as built.
+pub fn aperture_line(r: &ApertureResult) -> String {
+    let models: Vec<String> = r
+        .models
+        .iter()
+        .map(|m| {
+            format!(
+                "{} {} mm / {} %",
+                value_name(&m.model),
+                readable(m.rms_mm, 3),
+                readable(m.tension_change_pct, 3)
+            )
+        })
+        .collect();
+    format!(
+        "{} m: {} rings, {:.1}/{:.1} mm tube ({:.0} kg, margin {:.3}), hinges move {:.1} mm; \
+         RMS / tension change as built: {} ({:.0} s sizing)",
+        r.aperture_m,
+        r.rings,
+        1e3 * r.section.outer_diameter_m,
+        1e3 * r.section.inner_diameter_m,
+        r.truss_mass_kg,
+        r.margin,
+        r.hinge_motion_mm,
+        models.join(", "),
+        r.sizing_time_s
+    )
 }
 
 /// `ringmesh apertures`: reads the scene, runs the aperture study and

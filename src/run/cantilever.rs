@@ -5,6 +5,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use super::Summary;
 use crate::frame::cantilever::{self, CantileverRow};
 use crate::frame::FrameFileError;
 use crate::mechanics::ElementKind;
@@ -35,6 +36,84 @@ pub struct CantileverTable {
     pub element: String,
     /// One row per load `ML/(πEI)` of [`cantilever::M_RATIOS`].
     pub rows: Vec<CantileverTableRow>,
+}
+
+impl CantileverTable {
+    /// What `ringmesh cantilever` prints: the table as pretty JSON when
+    /// `as_json`, else as text, one load per line.
+    pub fn summary(&self, as_json: bool) -> Summary {
+        let mut s = Summary::default();
+        if as_json {
+            say!(
+                s,
+                "{}",
+                serde_json::to_string_pretty(self).expect("a table serialises")
+            );
+        } else {
+            self.text(&mut s);
+        }
+        s
+    }
+
+    /// The table as text, one load per line.
+    fn text(&self, s: &mut Summary) {
+        say!(
+            s,
+            "cantilever L = 10, EI = 100 under a tip moment: {} {} elements (paper §3.4, Tables 1-2)",
+            self.elements,
+            self.element
+        );
+        say!(
+            s,
+            "{:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} | {:>6} {:>5} {:>9}",
+            "ML/(πEI)",
+            "analytic",
+            "",
+            "paper",
+            "",
+            "ours",
+            "",
+            "rel. err",
+            "Newton",
+            "steps",
+            "time ms"
+        );
+        say!(
+            s,
+            "{:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>9} | {:>6} {:>5} {:>9}",
+            "",
+            "axial",
+            "vertical",
+            "axial",
+            "vertical",
+            "axial",
+            "vertical",
+            "",
+            "",
+            "",
+            ""
+        );
+        for r in &self.rows {
+            let paper = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.5}"));
+            let row = &r.row;
+            say!(
+                s,
+                "{:>9.1} | {:>9.5} {:>9.5} | {:>9} {:>9} | {:>9.5} {:>9.5} | {:>9.2e} | {:>6} {:>5} {:>9.3}{}",
+                row.m_ratio,
+                row.analytic_axial_m,
+                row.analytic_vertical_m,
+                paper(r.paper_axial_m),
+                paper(r.paper_vertical_m),
+                row.axial_m,
+                row.vertical_m,
+                row.relative_error,
+                row.newton_iterations,
+                row.load_steps,
+                1e3 * row.time_s,
+                if row.converged { "" } else { "  NOT CONVERGED" }
+            );
+        }
+    }
 }
 
 /// `ringmesh cantilever`: the paper's Tables 1–2 (§3.4) with `elements`

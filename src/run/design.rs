@@ -4,17 +4,17 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::default_output_dir;
+use super::{default_output_dir, Summary};
 use crate::design::{DesignReport, DesignSettings, IterationRecord, RelaxationKind};
 use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::report::{
-    assembly_vtu, cables_csv, convergence_csv, convergence_plot, surface_plot, write_atomic,
-    write_json, NodePanel, OutputSet, SurfaceFigure, WithRun,
+    assembly_vtu, cables_csv, convergence_csv, convergence_plot, json_name, readable, surface_plot,
+    write_atomic, write_json, NodePanel, OutputSet, SurfaceFigure, WithRun,
 };
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
-use crate::verify::Verification;
+use crate::verify::{CableModel, Verification};
 use crate::Error;
 
 /// What `ringmesh design` made.
@@ -24,6 +24,96 @@ pub struct DesignOutcome {
     pub report: DesignReport,
     /// Files written.
     pub written: Vec<PathBuf>,
+}
+
+impl DesignOutcome {
+    /// What `ringmesh design` prints: how the loop ended, the design and the
+    /// conventional one as built, the truss's margin, where the time went,
+    /// the net's warnings, the files written.
+    pub fn summary(&self) -> Summary {
+        let r = &self.report;
+        let mut s = Summary::default();
+        say!(
+            s,
+            "{}: {} after {} outer iterations of {}, boundary residual {:.3e} m, ratio {:.6}",
+            r.relaxation.name(),
+            json_name(&r.termination),
+            r.outer_iterations,
+            r.solver,
+            r.boundary_residual_m,
+            r.ratio
+        );
+        let v = &r.verification;
+        say!(
+            s,
+            "assembled{}: RMS {} mm (max {} mm), tension change {} %, boundary {} mm, {} slack cables",
+            cables_note(v),
+            readable(v.rms_mm, 4),
+            readable(v.max_deviation_mm, 4),
+            readable(v.max_tension_change_pct, 4),
+            readable(v.boundary_deviation_mm, 4),
+            v.slack_cables.len()
+        );
+        if let Some(c) = &r.conventional {
+            say!(
+                s,
+                "conventional (rigid-truss) design assembled{}: RMS {} mm (max {} mm), tension change {} %, {} slack cables",
+                cables_note(c),
+                readable(c.rms_mm, 4),
+                readable(c.max_deviation_mm, 4),
+                readable(c.max_tension_change_pct, 4),
+                c.slack_cables.len()
+            );
+        }
+        if let Some(m) = &r.limit_margin {
+            say!(s, "truss under the design's pull: {m}");
+        }
+        let t = &r.timings;
+        say!(
+            s,
+            "time: {:.2} s — mesh {:.2}, loop {:.2} (uniformity {:.2}, truss {:.2}), \
+             comparison loops {:.2}, margin {:.2}, verification {:.2}, conventional {:.2}, \
+             writing {:.2}",
+            t.total_s,
+            t.mesh_s,
+            t.design_loop_s(),
+            t.uniformity_s.iter().sum::<f64>(),
+            t.truss_s.iter().sum::<f64>(),
+            t.comparison_loops_s,
+            t.margin_s,
+            t.verification_s,
+            t.conventional_s,
+            t.writing_s
+        );
+        for w in &r.net.warnings {
+            say!(s, "warning: {w}");
+        }
+        s.written(&self.written);
+        s
+    }
+}
+
+/// One outer iteration of a design run, on one line (the CLI's progress on
+/// stderr).
+pub fn iteration_line(relaxation: RelaxationKind, r: &IterationRecord) -> String {
+    format!(
+        "{:>8} {:>3}  boundary change {:.3e} m  ratio {:.6}  truss Newton {}  {:.2} s",
+        relaxation.name(),
+        r.iteration,
+        r.boundary_change_max_m,
+        r.ratio,
+        r.oracle_newton_iterations,
+        r.elapsed_s
+    )
+}
+
+/// How the assembly's cables were modelled, when not as built (`[effects]
+/// cable_elasticity = false`).
+fn cables_note(v: &Verification) -> &'static str {
+    match v.cable_model {
+        CableModel::Elastic => "",
+        CableModel::Inextensible => " with inextensible cables",
+    }
 }
 
 /// `ringmesh design`: reads the scene, runs [`crate::design::run`] and writes

@@ -1,9 +1,10 @@
 //! `ringmesh fdm`: forward equilibrium of an interchange-format network.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::Summary;
 use crate::fdm::solve_network;
 use crate::network::Network;
 use crate::report::write_json;
@@ -24,8 +25,28 @@ pub struct FdmOutput {
     pub max_residual: f64,
 }
 
-/// `ringmesh fdm`: forward equilibrium of an interchange-format network.
-pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutput, Error> {
+/// What `ringmesh fdm` made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FdmOutcome {
+    /// The output (also in the file written).
+    pub output: FdmOutput,
+    /// The file written.
+    pub written: PathBuf,
+}
+
+impl FdmOutcome {
+    /// What `ringmesh fdm` prints: the largest residual, the file written.
+    pub fn summary(&self) -> Summary {
+        let mut s = Summary::default();
+        say!(s, "max residual: {:.3e} N", self.output.max_residual);
+        s.written(std::slice::from_ref(&self.written));
+        s
+    }
+}
+
+/// `ringmesh fdm`: forward equilibrium of an interchange-format network,
+/// written to `output_path`.
+pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutcome, Error> {
     let network = Network::read_json(network_path)?;
     let (_, equilibrium) = solve_network(&network)?;
     let output = FdmOutput {
@@ -36,5 +57,8 @@ pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutput, Error> 
         reactions: equilibrium.reactions_n,
     };
     write_json(output_path, &output)?;
-    Ok(output)
+    Ok(FdmOutcome {
+        output,
+        written: output_path.to_path_buf(),
+    })
 }

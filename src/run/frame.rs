@@ -5,12 +5,15 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::Summary;
 use crate::algebra::norm3;
 use crate::frame::{FrameFile, FrameFileError, NodeOrigin};
 use crate::mechanics::{
     rotation, CriticalPoint, MechanicsError, PathPoint, StaticSolver, StaticTermination, StepRecord,
 };
-use crate::report::{path_plot, readable, write_atomic, write_json, OutputSet, PathFigure};
+use crate::report::{
+    json_name, path_plot, readable, write_atomic, write_json, OutputSet, PathFigure,
+};
 use crate::Error;
 
 /// The path files written beside the frame's JSON.
@@ -135,6 +138,102 @@ impl FrameOutput {
     }
 }
 
+/// What `ringmesh frame` made.
+#[derive(Debug, Clone)]
+pub struct FrameOutcome {
+    /// The output (also in the JSON written).
+    pub output: FrameOutput,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+impl FrameOutcome {
+    /// What `ringmesh frame` prints: one paragraph (size, how the solve
+    /// ended, its largest results, the critical points), the files written;
+    /// a run short of its target has ended early.
+    pub fn summary(&self) -> Summary {
+        let mut s = Summary::default();
+        say!(s, "{}", frame_summary(&self.output));
+        s.written(&self.written);
+        s.ended_early = self.output.ended_early();
+        s
+    }
+}
+
+/// One paragraph: size, how the solve ended, and its largest results.
+fn frame_summary(o: &FrameOutput) -> String {
+    let c = &o.counts;
+    let ending = match o.termination {
+        StaticTermination::Converged => {
+            format!("reached its target at load factor {:.6}", o.load_factor)
+        }
+        StaticTermination::Stalled { load_factor } => {
+            format!("STALLED: the load step fell below the minimum at load factor {load_factor:.6}")
+        }
+        StaticTermination::LimitPoint { limit_load_factor } => {
+            format!("passed a LIMIT POINT at load factor {limit_load_factor:.6}")
+        }
+        StaticTermination::MaxSteps { load_factor } => {
+            format!("ran out of steps (MAX STEPS) at load factor {load_factor:.6}")
+        }
+        StaticTermination::Overflow { load_factor } => {
+            format!("OVERFLOWED beyond load factor {load_factor:.6}")
+        }
+    };
+    let reaction = o
+        .reactions
+        .iter()
+        .map(|r| norm3(r.force_n))
+        .fold(0.0, f64::max);
+    let moment = o
+        .reactions
+        .iter()
+        .map(|r| norm3(r.moment_nm))
+        .fold(0.0, f64::max);
+    let at = match o.nodes.get(o.max_displacement_node) {
+        Some(largest) => match (&largest.rod, largest.rod_node, &largest.body) {
+            (Some(rod), Some(i), _) => format!("rod {rod} node {i}"),
+            (_, _, Some(body)) => format!("body {body}"),
+            _ => format!("node {}", largest.id),
+        },
+        None => "no node".to_string(),
+    };
+    format!(
+        "{}: {} nodes ({} rods, {} elements, {} bodies, {} joints); {} in {} load steps, \
+         {} Newton iterations, {} rejected steps, {:.3} ms; largest displacement {:.6e} m \
+         at {at}; largest reaction {:.6e} N, {:.6e} N·m.",
+        o.file,
+        c.nodes,
+        c.rods,
+        c.elements,
+        c.bodies,
+        c.joints,
+        ending,
+        o.load_steps,
+        o.newton_iterations,
+        o.rejected_steps,
+        1e3 * o.time_s,
+        o.max_displacement_m,
+        reaction,
+        moment
+    ) + &o
+        .critical_points
+        .iter()
+        .map(|c| {
+            format!(
+                "\n  {} at load factor {:.9}{}",
+                json_name(&c.kind).replace('_', " "),
+                c.load_factor,
+                if c.switched_branch {
+                    " (followed its branch)"
+                } else {
+                    ""
+                }
+            )
+        })
+        .collect::<String>()
+}
+
 /// `ringmesh frame`: reads a frame file, follows its equilibrium path to
 /// the target (`[path]`, by default the full load) and writes every node's
 /// position, displacement and rotation, the reactions, the solver's
@@ -144,10 +243,7 @@ impl FrameOutput {
 /// first recorded node's displacement), all or none. Not reaching the target
 /// is a termination status in the output, not an error. Returns the output
 /// and the files written.
-pub fn frame(
-    frame_path: &Path,
-    output_path: Option<&Path>,
-) -> Result<(FrameOutput, Vec<PathBuf>), Error> {
+pub fn frame(frame_path: &Path, output_path: Option<&Path>) -> Result<FrameOutcome, Error> {
     let file = FrameFile::read(frame_path)?;
     let output_path =
         output_path.map_or_else(|| default_frame_output(frame_path), Path::to_path_buf);
@@ -275,7 +371,10 @@ pub fn frame(
         &set.path(PATH_SVG),
     )?;
     write_json(&set.path(&json_name), &output)?;
-    Ok((output, set.commit()?))
+    Ok(FrameOutcome {
+        output,
+        written: set.commit()?,
+    })
 }
 
 /// `frame-path.csv`: one row per converged step (`kind` = `step`) and per
@@ -312,7 +411,7 @@ fn path_csv(output: &FrameOutput) -> String {
         ));
         for c in output.critical_points.iter().filter(|c| c.after_point == i) {
             csv.push_str(&row(
-                crate::report::json_name(&c.kind).as_str(),
+                json_name(&c.kind).as_str(),
                 i,
                 c.load_factor,
                 c.lowest_stiffness_n_per_m,
@@ -357,7 +456,7 @@ fn path_figure(output: &FrameOutput) -> PathFigure {
                 (
                     x(&c.displacements_m, c.after_point),
                     c.load_factor,
-                    crate::report::json_name(&c.kind),
+                    json_name(&c.kind),
                 )
             })
             .collect(),

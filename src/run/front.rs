@@ -3,10 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{default_output_dir, write_shard, Progress};
+use super::{default_output_dir, write_shard, Progress, Summary};
 use crate::design::scene_problem;
 use crate::report::{
-    front_csv, front_plot, front_row, write_atomic, FrontRow, OutputSet, FRONT_COLUMNS,
+    front_csv, front_plot, front_row, json_name, write_atomic, FrontRow, OutputSet, FRONT_COLUMNS,
 };
 use crate::resources::{check_memory, check_scene, SceneCommand};
 use crate::scene::Scene;
@@ -14,6 +14,45 @@ use crate::shard::Shard;
 use crate::study;
 use crate::uniformity::{design_front_points, front_jobs, FrontPoint, SolverKind};
 use crate::Error;
+
+/// What `ringmesh front` made.
+#[derive(Debug)]
+pub struct FrontOutcome {
+    /// The points run, in sweep order.
+    pub points: Vec<FrontPoint>,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+impl FrontOutcome {
+    /// What `ringmesh front` prints: one line per point (its ratio, RMS and
+    /// time, or why it failed), the files written.
+    pub fn summary(&self) -> Summary {
+        let mut s = Summary::default();
+        for p in &self.points {
+            match &p.outcome {
+                Ok(t) => say!(
+                    s,
+                    "{} knob {:.3e}: ratio {:.6}, RMS {:.3e} mm, {:.3} s ({})",
+                    study::value_name(&p.solver),
+                    p.knob,
+                    p.ratio,
+                    p.rms_mm,
+                    p.time_s,
+                    json_name(t)
+                ),
+                Err(e) => say!(
+                    s,
+                    "{} knob {:.3e}: failed: {e}",
+                    study::value_name(&p.solver),
+                    p.knob
+                ),
+            }
+        }
+        s.written(&self.written);
+        s
+    }
+}
 
 /// `ringmesh front`: the design front of a scene (each solver's knob swept in
 /// parallel), written as `front.csv`, `front.png` and `front.svg`; with a
@@ -26,7 +65,7 @@ pub fn front(
     output_dir: Option<&Path>,
     shard: Option<Shard>,
     progress: &dyn Progress,
-) -> Result<(Vec<FrontPoint>, Vec<PathBuf>), Error> {
+) -> Result<FrontOutcome, Error> {
     let scene = Scene::read(scene_path)?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     // A shard writes one file under the folder's lock once computed; the
@@ -85,7 +124,10 @@ pub fn front(
             FRONT_COLUMNS,
             &rows,
         )?;
-        return Ok((front, vec![path]));
+        return Ok(FrontOutcome {
+            points: front,
+            written: vec![path],
+        });
     };
     let rows: Vec<FrontRow> = front.iter().filter_map(FrontRow::of).collect();
     let failed: Vec<(String, f64)> = front
@@ -94,7 +136,10 @@ pub fn front(
         .map(|p| (study::value_name(&p.solver), p.knob))
         .collect();
     let paths = write_front(set, &scene.name, &rows, Some(&failed), &front_csv(&rows))?;
-    Ok((front, paths))
+    Ok(FrontOutcome {
+        points: front,
+        written: paths,
+    })
 }
 
 /// Memory of one point of a front beside the solves: its job, its result,

@@ -5,15 +5,43 @@ use std::path::{Path, PathBuf};
 
 use super::front::{self, write_front};
 use super::study::{self, write_study};
+use super::Summary;
 use crate::report::OutputSet;
 use crate::report::{parse_front_row, parse_study_row, FrontRow};
 use crate::shard::{self, ShardError};
 use crate::study::StudyRow;
 use crate::Error;
 
-/// One sweep joined by `ringmesh merge`.
+/// What `ringmesh merge` made: one table per sweep joined.
 #[derive(Debug)]
 pub struct MergeOutcome {
+    /// The sweeps joined, in the order their shards were found.
+    pub tables: Vec<MergedTable>,
+}
+
+impl MergeOutcome {
+    /// What `ringmesh merge` prints: for each sweep, its command, scene,
+    /// shards and rows, and the files written.
+    pub fn summary(&self) -> Summary {
+        let mut s = Summary::default();
+        for m in &self.tables {
+            say!(
+                s,
+                "{} of {}: {} shards, {} rows",
+                m.command,
+                m.scene,
+                m.shards,
+                m.rows
+            );
+            s.written(&m.written);
+        }
+        s
+    }
+}
+
+/// One sweep joined by `ringmesh merge`.
+#[derive(Debug)]
+pub struct MergedTable {
     /// The command whose shards were joined (`front`, `study`).
     pub command: String,
     /// The scene's name.
@@ -31,7 +59,7 @@ pub struct MergeOutcome {
 /// as the unsharded run writes them, in `output_dir` (default
 /// `results/<scene>/`). Shards of different scenes or settings, duplicate or
 /// missing shards are refused before anything is written.
-pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOutcome>, Error> {
+pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<MergeOutcome, Error> {
     let files = shard::find_shards(paths)?
         .iter()
         .map(|p| shard::read_shard(p))
@@ -85,7 +113,7 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOu
                 write_study(set, &m.header.scene, &rows, &m.csv())?
             }
         };
-        outcomes.push(MergeOutcome {
+        outcomes.push(MergedTable {
             command: m.header.command.clone(),
             scene: m.header.scene.clone(),
             shards: m.files.len(),
@@ -93,5 +121,5 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<Vec<MergeOu
             written,
         });
     }
-    Ok(outcomes)
+    Ok(MergeOutcome { tables: outcomes })
 }

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::default_output_dir;
+use super::{default_output_dir, Summary};
 use crate::geometry::build_mesh;
 use crate::network::NetworkSummary;
 use crate::report::{network_vtu, write_atomic, write_json, OutputSet};
@@ -19,6 +19,18 @@ pub struct MeshOutcome {
     pub summary: NetworkSummary,
     /// Files written.
     pub written: Vec<PathBuf>,
+}
+
+impl MeshOutcome {
+    /// What `ringmesh mesh` prints: the scene, the net's counts and extreme
+    /// lengths, the files written.
+    pub fn summary(&self) -> Summary {
+        let mut s = Summary::default();
+        say!(s, "scene: {}", self.scene);
+        say!(s, "{}", self.summary.to_string().trim_end());
+        s.written(&self.written);
+        s
+    }
 }
 
 /// `ringmesh mesh`: builds the nets of a scene and writes `network.json` (the

@@ -1,9 +1,17 @@
 //! One file per CLI subcommand: read the inputs, call the library, write the
 //! outputs (all together or none, into a folder locked and checked before
-//! any computing: [`OutputSet`]), and return
-//! what the command prints. `main.rs` only parses arguments and calls these;
-//! the pipelines themselves live in the library ([`crate::design::run`],
-//! [`crate::study::run_study`], …).
+//! any computing: [`OutputSet`]), and return what the command made, whose
+//! `summary()` is what the command prints ([`Summary`]: its lines and how the
+//! run ended). `main.rs` only parses arguments, calls these, prints the
+//! summary and maps it to an exit code; the pipelines themselves live in the
+//! library ([`crate::design::run`], [`crate::study::run_study`], …).
+
+/// Appends one formatted entry to a [`Summary`]'s lines.
+macro_rules! say {
+    ($summary:expr, $($arg:tt)*) => {
+        $summary.lines.push(format!($($arg)*))
+    };
+}
 
 mod apertures;
 mod cantilever;
@@ -21,21 +29,22 @@ mod uniformity;
 
 use std::path::{Path, PathBuf};
 
-pub use apertures::{apertures, AperturesOutcome};
+pub use apertures::{aperture_line, apertures, AperturesOutcome};
 pub use cantilever::{cantilever, CantileverTable, CantileverTableRow};
-pub use design::{design, DesignOutcome};
-pub use fdm::{fdm, FdmOutput};
+pub use design::{design, iteration_line, DesignOutcome};
+pub use fdm::{fdm, FdmOutcome, FdmOutput};
 pub use frame::{
-    default_frame_output, frame, FrameCounts, FrameNodeOutput, FrameOutput, FrameReaction,
+    default_frame_output, frame, FrameCounts, FrameNodeOutput, FrameOutcome, FrameOutput,
+    FrameReaction,
 };
-pub use front::front;
-pub use merge::{merge, MergeOutcome};
+pub use front::{front, FrontOutcome};
+pub use merge::{merge, MergeOutcome, MergedTable};
 pub use mesh::{mesh, MeshOutcome};
-pub use optimize::optimize;
-pub use size::{size, SizeOutcome};
+pub use optimize::{optimize, OptimizeOutcome};
+pub use size::{section_line, size, SizeOutcome};
 pub use study::{study, StudyOptions, StudyOutcome, STUDY_STEM};
-pub use truss::truss;
-pub use uniformity::{uniformity, UniformityOutput};
+pub use truss::{truss, TrussOutcome};
+pub use uniformity::{uniformity, UniformityOutcome, UniformityOutput};
 
 use crate::report::OutputSet;
 use crate::scene::Scene;
@@ -49,6 +58,27 @@ pub trait Progress: Sync {
     fn start(&self, _total: usize) {}
     /// One step finished.
     fn step(&self, _message: &str) {}
+}
+
+/// What a command prints on stdout, and how its run ended.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Summary {
+    /// The text, in order: each entry is printed followed by a newline (an
+    /// entry may itself hold several lines).
+    pub lines: Vec<String>,
+    /// Why a run that wrote its results ended before its target (a `frame`
+    /// run short of the full load), or `None` when it reached it. The CLI
+    /// exits 3 then.
+    pub ended_early: Option<String>,
+}
+
+impl Summary {
+    /// One `wrote PATH` line per file written.
+    pub(crate) fn written(&mut self, paths: &[PathBuf]) {
+        for path in paths {
+            say!(self, "wrote {}", path.display());
+        }
+    }
 }
 
 /// A [`Progress`] that ignores everything.

@@ -5,9 +5,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::default_output_dir;
+use super::{default_output_dir, Summary};
 use crate::design::{default_solver, scene_problem};
-use crate::report::{cables_csv, write_atomic, write_json, OutputSet, WithRun};
+use crate::report::{
+    cables_csv, json_name, readable, write_atomic, write_json, OutputSet, WithRun,
+};
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
 use crate::uniformity::{Design, SolverKind};
@@ -21,6 +23,56 @@ struct DesignFile<'a> {
     design: &'a Design,
 }
 
+/// What `ringmesh optimize` made.
+#[derive(Debug, Clone)]
+pub struct OptimizeOutcome {
+    /// The design (also in `design.json`).
+    pub design: Design,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+impl OptimizeOutcome {
+    /// What `ringmesh optimize` prints: the ratio of each uniformity set, the
+    /// surface RMS, how the solver ended, its route and warnings, the files
+    /// written.
+    pub fn summary(&self) -> Summary {
+        let d = &self.design;
+        let mut s = Summary::default();
+        for set in &d.sets {
+            say!(
+                s,
+                "ratio over {}: {:.6} ({} cables)",
+                set.name,
+                set.ratio,
+                set.cables
+            );
+        }
+        say!(
+            s,
+            "surface RMS: {} mm (max {} mm)",
+            readable(1e3 * d.surface_rms_m, 4),
+            readable(1e3 * d.surface_max_m, 4)
+        );
+        say!(
+            s,
+            "termination: {} after {} iterations of {}, {:.3} s",
+            json_name(&d.termination),
+            d.iterations,
+            d.solver,
+            d.time_s
+        );
+        if let Some(route) = d.route {
+            say!(s, "route: {route}");
+        }
+        for w in &d.warnings {
+            say!(s, "warning: {w}");
+        }
+        s.written(&self.written);
+        s
+    }
+}
+
 /// `ringmesh optimize`: one design for the theoretical boundary, written as
 /// `design.json` and `cables.csv` (with cut lengths); `solver` defaults to
 /// the scene's ([`default_solver`]).
@@ -28,7 +80,7 @@ pub fn optimize(
     scene_path: &Path,
     solver: Option<SolverKind>,
     output_dir: Option<&Path>,
-) -> Result<(Design, Vec<PathBuf>), Error> {
+) -> Result<OptimizeOutcome, Error> {
     let scene = Scene::read(scene_path)?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     check_scene(&scene, SceneCommand::Optimize, 1)?;
@@ -50,5 +102,8 @@ pub fn optimize(
             report: &file,
         },
     )?;
-    Ok((design, set.commit()?))
+    Ok(OptimizeOutcome {
+        design,
+        written: set.commit()?,
+    })
 }

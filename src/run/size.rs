@@ -3,9 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::default_output_dir;
+use super::{default_output_dir, Summary};
 use crate::design::DesignSettings;
-use crate::report::{sizing_csv, write_atomic, OutputSet};
+use crate::mechanics::LimitBound;
+use crate::report::{readable, sizing_csv, write_atomic, OutputSet};
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
 use crate::sizing::{catalogue, size_truss, SectionTrial, Sections, Sizing};
@@ -18,6 +19,59 @@ pub struct SizeOutcome {
     pub sizing: Sizing,
     /// Files written.
     pub written: Vec<PathBuf>,
+}
+
+impl SizeOutcome {
+    /// What `ringmesh size` prints: the section chosen and how many were
+    /// tried, the files written.
+    pub fn summary(&self) -> Summary {
+        let s = &self.sizing;
+        let chosen = &s.trials[s.chosen];
+        let mut summary = Summary::default();
+        say!(
+            summary,
+            "lightest section with a margin ≥ {} of {} tried: {}",
+            s.margin,
+            s.trials.len(),
+            section_line(chosen)
+        );
+        summary.written(&self.written);
+        summary
+    }
+}
+
+/// One section a sizing tried, on one line: the tube, its mass and margin,
+/// whether it carries the net, its design's iterations and RMS as built
+/// (or why it has no design), the time.
+pub fn section_line(t: &SectionTrial) -> String {
+    let c = &t.section;
+    let outcome = match (&t.failure, t.rms_mm) {
+        (Some(f), _) => format!("no design: {f}"),
+        (None, Some(rms)) => format!(
+            "{} outer iterations, RMS as built {} mm",
+            t.outer_iterations,
+            readable(rms, 3)
+        ),
+        (None, None) => String::new(),
+    };
+    format!(
+        "{:.1}/{:.1} mm tube: {:.0} kg, margin {:.3}{}, {}; {outcome} ({:.1} s)",
+        1e3 * c.outer_diameter_m,
+        1e3 * c.inner_diameter_m,
+        t.mass_kg,
+        t.margin,
+        if t.bound == Some(LimitBound::SearchEnd) {
+            " (searched to its end)"
+        } else {
+            ""
+        },
+        if t.carries {
+            "carries"
+        } else {
+            "does not carry"
+        },
+        t.time_s
+    )
 }
 
 /// `ringmesh size`: reads the scene (and the catalogue `sections`, if

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{default_output_dir, write_shard, Progress};
+use super::{default_output_dir, write_shard, Progress, Summary};
 use crate::report::{study_csv, study_plot, study_row, write_atomic, OutputSet, STUDY_COLUMNS};
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::{Scene, TrussModel};
@@ -86,6 +86,66 @@ pub struct StudyOutcome {
     pub points: usize,
     /// Files written.
     pub written: Vec<PathBuf>,
+}
+
+impl StudyOutcome {
+    /// What `ringmesh study` prints: a table of the points run (knob,
+    /// value, design time, accuracy as built, or why a point failed), the
+    /// files written.
+    pub fn summary(&self) -> Summary {
+        let mut s = Summary::default();
+        say!(
+            s,
+            "{}: {} of {} points (time: design wall time; accuracy: as built on the reference truss)",
+            self.scene,
+            self.rows.len(),
+            self.points
+        );
+        say!(
+            s,
+            "{:>5} {:>10} {:>13} {:>9} {:>10} {:>11} {:>11} {:>13} {:>13}",
+            "point",
+            "knob",
+            "value",
+            "time s",
+            "RMS mm",
+            "ratio err",
+            "tension %",
+            "cut len mm",
+            "facet RMS mm"
+        );
+        for (k, r) in &self.rows {
+            let value = if r.value.is_empty() { "-" } else { &r.value };
+            let g = |v: f64| {
+                if v.is_finite() {
+                    format!("{v:.3e}")
+                } else {
+                    "-".into()
+                }
+            };
+            match &r.error {
+                Some(e) => say!(
+                    s,
+                    "{k:>5} {:>10} {value:>13} {:>9.3}  failed: {e}",
+                    r.knob.name(),
+                    r.time_s
+                ),
+                None => say!(
+                    s,
+                    "{k:>5} {:>10} {value:>13} {:>9.3} {:>10} {:>11} {:>11} {:>13} {:>13}",
+                    r.knob.name(),
+                    r.time_s,
+                    g(r.rms_mm),
+                    g(r.ratio_error),
+                    g(r.tension_change_pct),
+                    g(r.cut_length_error_mm),
+                    g(r.facet_rms_mm)
+                ),
+            }
+        }
+        s.written(&self.written);
+        s
+    }
 }
 
 /// The study's file stem, as a literal (`concat!` builds [`FILES`] from it).

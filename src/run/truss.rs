@@ -3,11 +3,48 @@
 
 use std::path::{Path, PathBuf};
 
-use super::default_output_dir;
+use super::{default_output_dir, Summary};
 use crate::report::write_json;
 use crate::scene::{Scene, TrussModel};
 use crate::truss::SceneTrussResponse;
 use crate::Error;
+
+/// What `ringmesh truss` made.
+#[derive(Debug, Clone)]
+pub struct TrussOutcome {
+    /// The response (also in the file written).
+    pub response: SceneTrussResponse,
+    /// The file written.
+    pub written: PathBuf,
+}
+
+impl TrussOutcome {
+    /// What `ringmesh truss` prints: the model, the loads, the largest
+    /// displacement and the solver's statistics, each attachment's
+    /// displacement, the file written.
+    pub fn summary(&self) -> Summary {
+        let r = &self.response;
+        let mut s = Summary::default();
+        say!(
+            s,
+            "{} truss under loads from {}: max displacement {:.6e} m, {} Newton iterations, {} load steps, {:.3} s",
+            r.model, r.loads_from, r.max_displacement_m, r.newton_iterations, r.load_steps, r.time_s
+        );
+        for a in &r.attachments {
+            let d = a.displacement_m;
+            say!(
+                s,
+                "  {:<10} u = [{:+.4e}, {:+.4e}, {:+.4e}] m",
+                a.hinge,
+                d[0],
+                d[1],
+                d[2]
+            );
+        }
+        s.written(std::slice::from_ref(&self.written));
+        s
+    }
+}
 
 /// `ringmesh truss`: the scene's truss model (default: the scene's
 /// `[effects] truss`) under the pull of its net (forward FDM with the initial
@@ -18,7 +55,7 @@ pub fn truss(
     model: Option<TrussModel>,
     loads_path: Option<&Path>,
     output_path: Option<&Path>,
-) -> Result<(SceneTrussResponse, PathBuf), Error> {
+) -> Result<TrussOutcome, Error> {
     let scene = Scene::read(scene_path)?;
     let model = model.unwrap_or(scene.effects.truss);
     let loads = match loads_path {
@@ -31,5 +68,8 @@ pub fn truss(
         Path::to_path_buf,
     );
     write_json(&path, &response)?;
-    Ok((response, path))
+    Ok(TrussOutcome {
+        response,
+        written: path,
+    })
 }

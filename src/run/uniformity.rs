@@ -1,13 +1,14 @@
 //! `ringmesh uniformity`: the uniformity problem on an interchange-format
 //! network whose node positions are the prescribed geometry.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::Summary;
 use crate::algebra::norm3;
 use crate::network::Network;
-use crate::report::write_json;
+use crate::report::{json_name, write_json};
 use crate::uniformity::{
     Route, SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem,
     UniformitySet,
@@ -41,6 +42,42 @@ pub struct UniformityOutput {
     pub warnings: Vec<String>,
 }
 
+/// What `ringmesh uniformity` made.
+#[derive(Debug, Clone)]
+pub struct UniformityOutcome {
+    /// The output (also in the file written).
+    pub output: UniformityOutput,
+    /// The file written.
+    pub written: PathBuf,
+}
+
+impl UniformityOutcome {
+    /// What `ringmesh uniformity` prints: the ratio, the residual, how the
+    /// solver ended, its route and warnings, the file written.
+    pub fn summary(&self) -> Summary {
+        let o = &self.output;
+        let mut s = Summary::default();
+        say!(s, "ratio: {:.6}", o.ratio);
+        say!(s, "max residual: {:.3e} N", o.max_residual);
+        say!(
+            s,
+            "termination: {} after {} iterations of {}, {:.3} s",
+            json_name(&o.termination),
+            o.iterations,
+            o.solver,
+            o.time_s
+        );
+        if let Some(route) = o.route {
+            say!(s, "route: {route}");
+        }
+        for w in &o.warnings {
+            say!(s, "warning: {w}");
+        }
+        s.written(std::slice::from_ref(&self.written));
+        s
+    }
+}
+
 /// `ringmesh uniformity`: the uniformity problem on a network whose node
 /// positions are the prescribed geometry. `groups`: the uniformity set is their
 /// union (default `front` when the file has groups, else every cable);
@@ -54,7 +91,7 @@ pub fn uniformity(
     mean_tension_n: Option<f64>,
     max_force_density_n_per_m: f64,
     output_path: &Path,
-) -> Result<UniformityOutput, Error> {
+) -> Result<UniformityOutcome, Error> {
     let network = Network::read_json(network_path)?;
     let default_groups = vec!["front".to_string()];
     let groups: Vec<String> = match (groups, &network.groups) {
@@ -125,5 +162,8 @@ pub fn uniformity(
         warnings: design.warnings,
     };
     write_json(output_path, &output)?;
-    Ok(output)
+    Ok(UniformityOutcome {
+        output,
+        written: output_path.to_path_buf(),
+    })
 }

@@ -1,0 +1,283 @@
+//! A scene's values against their valid ranges ([`Scene::validate`]), the
+//! limits among them; an invalid value is a [`SceneError`] naming the dotted
+//! key and the reason.
+
+use super::error::SceneError;
+use super::schema::{membrane_tension_n, Scene};
+
+/// Longest scene name: it names the results folder and files made from it.
+pub const MAX_NAME_LEN: usize = 128;
+
+/// Largest elastic modulus a scene may give, Pa (diamond: 1.2e12).
+pub const MAX_MODULUS_PA: f64 = 1e13;
+
+/// Tallest truss, as a multiple of the aperture diameter (real rings:
+/// 0.1–0.6).
+pub const MAX_HEIGHT_RATIO: f64 = 10.0;
+
+/// Largest number of beam elements per truss rod.
+pub const MAX_ELEMENTS_PER_ROD: usize = 64;
+
+/// Largest number of bays a scene may ask for.
+pub const MAX_BAYS: usize = 1_000;
+
+impl Scene {
+    /// Checks every value against its valid range.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        if self.name.is_empty()
+            || !self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+            || self.name.starts_with('.')
+        {
+            return Err(SceneError::invalid(
+                "name",
+                format!(
+                    "{:?} must be non-empty and use only letters, digits, '-', '_' and '.' \
+                     (it names the results folder)",
+                    self.name
+                ),
+            ));
+        }
+        if self.name.len() > MAX_NAME_LEN {
+            return Err(SceneError::invalid(
+                "name",
+                format!(
+                    "{} characters, at most {MAX_NAME_LEN}: it names the results folder and \
+                     files (`<name>-sized.toml`, `<name>-at-100m.toml`) that file systems \
+                     limit to 255 bytes",
+                    self.name.len()
+                ),
+            ));
+        }
+        let r = &self.reflector;
+        positive("reflector.aperture_diameter_m", r.aperture_diameter_m)?;
+        positive("reflector.focal_length_m", r.focal_length_m)?;
+        non_negative("reflector.offset_m", r.offset_m)?;
+
+        let t = &self.truss;
+        if t.bays < 3 {
+            return Err(SceneError::invalid(
+                "truss.bays",
+                format!("{} bays: a ring truss needs at least 3", t.bays),
+            ));
+        }
+        if t.bays > MAX_BAYS {
+            return Err(SceneError::invalid(
+                "truss.bays",
+                format!("{} bays: more than the {MAX_BAYS} supported", t.bays),
+            ));
+        }
+        positive("truss.height_m", t.height_m)?;
+        let diameter = self.reflector.aperture_diameter_m;
+        if t.height_m > MAX_HEIGHT_RATIO * diameter {
+            return Err(SceneError::invalid(
+                "truss.height_m",
+                format!(
+                    "{:e} m is more than {MAX_HEIGHT_RATIO} × the aperture ({diameter} m): the \
+                     ties would span decades more than the net's cables, beyond what one \
+                     force density solve balances",
+                    t.height_m
+                ),
+            ));
+        }
+        if !(1..=MAX_ELEMENTS_PER_ROD).contains(&t.elements_per_rod) {
+            return Err(SceneError::invalid(
+                "truss.elements_per_rod",
+                format!("{} must be in 1…{MAX_ELEMENTS_PER_ROD}", t.elements_per_rod),
+            ));
+        }
+        positive("truss.tube_outer_diameter_m", t.tube_outer_diameter_m)?;
+        non_negative("truss.tube_inner_diameter_m", t.tube_inner_diameter_m)?;
+        if t.tube_inner_diameter_m >= t.tube_outer_diameter_m {
+            return Err(SceneError::invalid(
+                "truss.tube_inner_diameter_m",
+                format!(
+                    "{} m must be smaller than truss.tube_outer_diameter_m = {} m",
+                    t.tube_inner_diameter_m, t.tube_outer_diameter_m
+                ),
+            ));
+        }
+        modulus("truss.youngs_modulus_pa", t.youngs_modulus_pa)?;
+        modulus("truss.shear_modulus_pa", t.shear_modulus_pa)?;
+        positive("truss.density_kg_per_m3", t.density_kg_per_m3)?;
+        non_negative("truss.hinge_mass_kg", t.hinge_mass_kg)?;
+
+        let f = &self.front_net;
+        if f.rings < 2 {
+            return Err(SceneError::invalid(
+                "front_net.rings",
+                format!(
+                    "{} ring(s): at least 2 are needed for free boundary nodes between \
+                     the truss attachments",
+                    f.rings
+                ),
+            ));
+        }
+        positive("front_net.boundary_sag_ratio", f.boundary_sag_ratio)?;
+        if f.boundary_sag_ratio >= 0.5 {
+            return Err(SceneError::invalid(
+                "front_net.boundary_sag_ratio",
+                format!(
+                    "{} must be below 0.5 (sag as a fraction of the bay chord)",
+                    f.boundary_sag_ratio
+                ),
+            ));
+        }
+        let tension = membrane_tension_n(self, 1.0);
+        one_tension_of(
+            "front_net",
+            f.mean_tension_n,
+            f.membrane_stress_n_per_m,
+            tension,
+        )?;
+        positive("rear_net.focal_length_m", self.rear_net.focal_length_m)?;
+        let r = &self.rear_net;
+        one_tension_of(
+            "rear_net",
+            r.mean_tension_n,
+            r.membrane_stress_n_per_m,
+            tension,
+        )?;
+
+        let u = &self.uniformity;
+        if u.groups.is_empty() {
+            return Err(SceneError::invalid(
+                "uniformity.groups",
+                "at least one group is needed",
+            ));
+        }
+        if let Some(g) = u
+            .groups
+            .iter()
+            .enumerate()
+            .find_map(|(i, g)| u.groups[..i].contains(g).then_some(g))
+        {
+            return Err(SceneError::invalid(
+                "uniformity.groups",
+                format!("{g:?} is listed twice"),
+            ));
+        }
+        if !(u.min_tension_fraction > 0.0 && u.min_tension_fraction < 1.0) {
+            return Err(SceneError::invalid(
+                "uniformity.min_tension_fraction",
+                format!("{} must lie in (0, 1)", u.min_tension_fraction),
+            ));
+        }
+
+        if self
+            .effects
+            .rod_properties_csv
+            .as_ref()
+            .is_some_and(|f| f.as_os_str().is_empty())
+        {
+            return Err(SceneError::invalid(
+                "effects.rod_properties_csv",
+                "must name a CSV file (relative to the scene's folder)",
+            ));
+        }
+        if let Some(table) = &self.effects.rod_properties {
+            table.check_bays(t.bays)?;
+        }
+
+        let c = &self.cables;
+        positive("cables.diameter_m", c.diameter_m)?;
+        modulus("cables.youngs_modulus_pa", c.youngs_modulus_pa)?;
+        positive("cables.density_kg_per_m3", c.density_kg_per_m3)?;
+        positive(
+            "cables.max_force_density_n_per_m",
+            c.max_force_density_n_per_m,
+        )?;
+        if let Some(g) = &self.effects.gravity {
+            non_negative(
+                "effects.gravity.acceleration_m_per_s2",
+                g.acceleration_m_per_s2,
+            )?;
+            let norm = g.direction.iter().map(|c| c * c).sum::<f64>().sqrt();
+            if !(norm.is_finite() && norm > 0.0) {
+                return Err(SceneError::invalid(
+                    "effects.gravity.direction",
+                    format!("{:?} must be a finite, non-zero vector", g.direction),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Exactly one of `<net>.mean_tension_n` and `<net>.membrane_stress_n_per_m`
+/// (a resolved scene has both, consistent: `tension_per_stress` N per N/m).
+fn one_tension_of(
+    net: &'static str,
+    mean_tension_n: f64,
+    stress: Option<f64>,
+    tension_per_stress: f64,
+) -> Result<(), SceneError> {
+    let (mean_key, stress_key) = match net {
+        "front_net" => (
+            "front_net.mean_tension_n",
+            "front_net.membrane_stress_n_per_m",
+        ),
+        _ => (
+            "rear_net.mean_tension_n",
+            "rear_net.membrane_stress_n_per_m",
+        ),
+    };
+    match stress {
+        None if mean_tension_n == 0.0 => Err(SceneError::invalid(
+            mean_key,
+            format!("missing: give `{mean_key}` (N) or `{stress_key}` (N/m)"),
+        )),
+        None => positive(mean_key, mean_tension_n),
+        Some(n) => {
+            positive(stress_key, n)?;
+            let resolved = n * tension_per_stress;
+            if (mean_tension_n - resolved).abs() > 1e-12 * resolved {
+                return Err(SceneError::invalid(
+                    stress_key,
+                    format!(
+                        "give either `{mean_key}` or `{stress_key}`, not both (the stress \
+                         means {resolved:.6} N)"
+                    ),
+                ));
+            }
+            Ok(())
+        }
+    }
+}
+
+/// An elastic modulus: positive, and at most [`MAX_MODULUS_PA`] (stiffer than
+/// any material; 1e300 made the truss's Newton 'converge' in 0 iterations).
+fn modulus(key: &'static str, value: f64) -> Result<(), SceneError> {
+    positive(key, value)?;
+    if value > MAX_MODULUS_PA {
+        return Err(SceneError::invalid(
+            key,
+            format!("{value:e} Pa is stiffer than any material (at most {MAX_MODULUS_PA:e} Pa)"),
+        ));
+    }
+    Ok(())
+}
+
+fn positive(key: &'static str, value: f64) -> Result<(), SceneError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(
+            key,
+            format!("{value} must be a finite number > 0"),
+        ))
+    }
+}
+
+fn non_negative(key: &'static str, value: f64) -> Result<(), SceneError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(
+            key,
+            format!("{value} must be a finite number ≥ 0"),
+        ))
+    }
+}
