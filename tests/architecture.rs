@@ -170,12 +170,15 @@ impl Crate {
         Crate::read_tree(&common::source_dir())
     }
 
-    /// The crate whose root (`lib.rs`) is in `root`; the binary (`main.rs`)
-    /// and unit-test files (`tests.rs`) are left out.
+    /// The crate whose root (`lib.rs`) is in `root`; the binary (`main.rs`,
+    /// `cli.rs`) and unit-test files (`tests.rs`) are left out.
     fn read_tree(root: &Path) -> Crate {
         let mut paths = Vec::new();
         rust_files(root, &mut paths);
-        paths.retain(|p| !(p.ends_with("main.rs") || p.ends_with("tests.rs")));
+        paths.retain(|p| {
+            let binary = root.join("main.rs") == *p || root.join("cli.rs") == *p;
+            !(binary || p.ends_with("tests.rs"))
+        });
         let files: BTreeMap<Vec<String>, PathBuf> = paths
             .iter()
             .map(|p| (module_of(root, p), p.clone()))
