@@ -581,3 +581,62 @@ fn the_guard_follows_a_module_imported_by_name() {
         ],
     );
 }
+
+/// The top-level modules in the order of docs/ARCHITECTURE.md's layer table
+/// (its first column's names, `a.rs`/`a/` → `a`), lowest first.
+fn documented_layers() -> Vec<String> {
+    let doc = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ARCHITECTURE.md"),
+    )
+    .unwrap();
+    let table = doc
+        .split("## Layers")
+        .nth(1)
+        .and_then(|s| s.split("\n## ").next())
+        .expect("docs/ARCHITECTURE.md has a Layers section");
+    let mut layers = Vec::new();
+    for line in table.lines().filter(|l| l.starts_with("| `")) {
+        let first = line.split('|').nth(1).unwrap();
+        for name in first.split('`').skip(1).step_by(2) {
+            let name = name.trim_end_matches('/').trim_end_matches(".rs");
+            if !layers.iter().any(|l| l == name) {
+                layers.push(name.to_string());
+            }
+        }
+    }
+    layers
+}
+
+/// docs/ARCHITECTURE.md's claim: a module uses only the modules listed
+/// before it (the layer table runs from the bottom up), and the table names
+/// every top-level module.
+#[test]
+fn every_module_uses_only_the_layers_the_architecture_lists_below_it() {
+    let root = common::source_dir();
+    let layers = documented_layers();
+    let rank = |m: &str| layers.iter().position(|l| l == m);
+    let mut unlisted = BTreeSet::new();
+    let mut upward = Vec::new();
+    for (file, targets) in Crate::read().graph() {
+        let Some(from) = module_of(&root, &file).first().cloned() else {
+            continue;
+        };
+        for t in targets {
+            let Some(to) = module_of(&root, &t).first().cloned() else {
+                continue;
+            };
+            match (rank(&from), rank(&to)) {
+                (Some(a), Some(b)) if b > a => upward.push(format!(
+                    "{} uses {}",
+                    file.strip_prefix(&root).unwrap().display(),
+                    t.strip_prefix(&root).unwrap().display()
+                )),
+                (None, _) => drop(unlisted.insert(from.clone())),
+                (_, None) => drop(unlisted.insert(to)),
+                _ => {}
+            }
+        }
+    }
+    assert!(unlisted.is_empty(), "modules the table does not list: {unlisted:?}");
+    assert!(upward.is_empty(), "uses of a higher layer: {upward:#?}");
+}
