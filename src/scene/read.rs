@@ -51,7 +51,9 @@ impl Scene {
         if scene.name.is_empty() {
             scene.name = default_name.to_string();
         }
-        scene.resolve_tensions();
+        if !scene.front_net.rings_to_choose() {
+            scene.resolve_tensions();
+        }
         scene.validate()?;
         scene.read_effect_files(folder)?;
         Ok(scene)
@@ -80,6 +82,26 @@ impl Scene {
 
     /// Sets each net's mean tension from its membrane stress, where the file
     /// gives that instead (`validate` then checks the pair).
+    /// The scene with its front net's rings set to `rings` (a scene whose
+    /// file left them to `[surface] rms_mm`): the mean tensions that a
+    /// membrane stress gives resolved for that net, and the whole validated.
+    ///
+    /// # Errors
+    /// A scene that is invalid with these rings, naming the key.
+    pub fn with_rings(mut self, rings: usize) -> Result<Scene, SceneError> {
+        self.front_net.rings = rings;
+        // A mean tension given as a membrane stress follows the net's spacing.
+        if self.front_net.membrane_stress_n_per_m.is_some() {
+            self.front_net.mean_tension_n = 0.0;
+        }
+        if self.rear_net.membrane_stress_n_per_m.is_some() {
+            self.rear_net.mean_tension_n = 0.0;
+        }
+        self.resolve_tensions();
+        self.validate()?;
+        Ok(self)
+    }
+
     fn resolve_tensions(&mut self) {
         let per_unit_stress = membrane_tension_n(self, 1.0);
         for (mean, stress) in [

@@ -31,6 +31,41 @@ pub struct Scene {
     /// Which physics the model includes (DESIGN §8).
     #[serde(default)]
     pub effects: Effects,
+    /// The surface accuracy the dish must hold, and its band.
+    #[serde(default, skip_serializing_if = "SurfaceSpec::is_empty")]
+    pub surface: SurfaceSpec,
+}
+
+/// The surface a dish must hold, as its engineer states it (`[surface]`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SurfaceSpec {
+    /// Target facet RMS of the design surface, mm: the flat facets of the
+    /// front net with their corners on the paraboloid, their axial deviation
+    /// integrated over plan area (`surface::facet_rms`). Without
+    /// `front_net.rings`, the coarsest net that meets it is chosen; with
+    /// them, whether it is met is reported.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rms_mm: Option<f64>,
+    /// Operating frequency, GHz: the gain lost to the surface error (Ruze)
+    /// is reported at it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frequency_ghz: Option<f64>,
+}
+
+impl FrontNet {
+    /// True when the file left the rings to the surface target: the scene is
+    /// complete once they are chosen (`surface::resolve_front_rings`).
+    pub fn rings_to_choose(&self) -> bool {
+        self.rings == 0
+    }
+}
+
+impl SurfaceSpec {
+    /// True when the scene states neither a target nor a band.
+    pub fn is_empty(&self) -> bool {
+        self.rms_mm.is_none() && self.frequency_ghz.is_none()
+    }
 }
 
 /// A net whose interior tensions can be made uniform.
@@ -138,7 +173,10 @@ fn default_elements_per_rod() -> usize {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrontNet {
-    /// Subdivisions of each sector's radial edge (rings of the grid).
+    /// Subdivisions of each sector's radial edge (rings of the grid); absent
+    /// (0) when `[surface] rms_mm` is to choose them
+    /// ([`FrontNet::rings_to_choose`]).
+    #[serde(default)]
     pub rings: usize,
     /// Inward sag of the boundary at mid-bay, as a fraction of the bay chord.
     pub boundary_sag_ratio: f64,

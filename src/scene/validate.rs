@@ -105,7 +105,22 @@ impl Scene {
         non_negative("truss.hinge_mass_kg", t.hinge_mass_kg)?;
 
         let f = &self.front_net;
-        if f.rings < 2 {
+        let target = self.surface.rms_mm;
+        if let Some(rms) = target {
+            positive("surface.rms_mm", rms)?;
+        }
+        if let Some(ghz) = self.surface.frequency_ghz {
+            positive("surface.frequency_ghz", ghz)?;
+        }
+        if f.rings_to_choose() && target.is_none() {
+            return Err(SceneError::invalid(
+                "front_net.rings",
+                "missing: give the rings, or `[surface] rms_mm` to choose the coarsest net \
+                 that holds it"
+                    .to_string(),
+            ));
+        }
+        if f.rings < 2 && !f.rings_to_choose() {
             return Err(SceneError::invalid(
                 "front_net.rings",
                 format!(
@@ -125,7 +140,9 @@ impl Scene {
                 ),
             ));
         }
-        let tension = membrane_tension_n(self, 1.0);
+        // The tension a membrane stress means depends on the net's spacing:
+        // unknown while the rings are still to choose.
+        let tension = (!f.rings_to_choose()).then(|| membrane_tension_n(self, 1.0));
         one_tension_of(
             "front_net",
             f.mean_tension_n,
@@ -207,12 +224,13 @@ impl Scene {
 }
 
 /// Exactly one of `<net>.mean_tension_n` and `<net>.membrane_stress_n_per_m`
-/// (a resolved scene has both, consistent: `tension_per_stress` N per N/m).
+/// (a resolved scene has both, consistent: `tension_per_stress` N per N/m;
+/// `None` while the net's rings, which set it, are still to choose).
 fn one_tension_of(
     net: &'static str,
     mean_tension_n: f64,
     stress: Option<f64>,
-    tension_per_stress: f64,
+    tension_per_stress: Option<f64>,
 ) -> Result<(), SceneError> {
     let (mean_key, stress_key) = match net {
         "front_net" => (
@@ -232,6 +250,9 @@ fn one_tension_of(
         None => positive(mean_key, mean_tension_n),
         Some(n) => {
             positive(stress_key, n)?;
+            let Some(tension_per_stress) = tension_per_stress else {
+                return Ok(());
+            };
             let resolved = n * tension_per_stress;
             if (mean_tension_n - resolved).abs() > 1e-12 * resolved {
                 return Err(SceneError::invalid(
