@@ -1,0 +1,203 @@
+//! The surface module's claims: closed forms, quadrature against brute force,
+//! best fits of moved paraboloids, DESIGN §12's facet estimates, the net
+//! chosen for a target.
+
+use super::samples::plan_area_m2;
+use super::*;
+use crate::geometry::{build_mesh, Paraboloid};
+use crate::scene::Scene;
+
+fn design(focal_length_m: f64) -> Paraboloid {
+    Paraboloid { focal_length_m }
+}
+
+fn on(p: &Paraboloid, [x, y]: [f64; 2]) -> [f64; 3] {
+    [x, y, p.z(x, y)]
+}
+
+fn scene(name: &str) -> Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(name);
+    Scene::read(&path).unwrap()
+}
+
+fn front_net(scene: &Scene, rings: usize) -> FacetNet {
+    let mut s = scene.clone();
+    s.front_net.rings = rings;
+    FacetNet::front_of(&build_mesh(&s).unwrap())
+}
+
+/// Mean and mean square of the axial deviation of a flat facet with corners
+/// `plan` on the paraboloid: the deviation is `Σᵢ<ⱼ λᵢλⱼ ℓᵢⱼ²/(4F)`, and over
+/// the triangle E[λᵢλⱼ] = 1/12, E[λᵢ²λⱼ²] = 1/90, E[λᵢ²λⱼλₖ] = 1/180.
+fn bubble_moments(plan: [[f64; 2]; 3], f: f64) -> (f64, f64) {
+    let sq = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    let s = [sq(plan[0], plan[1]), sq(plan[1], plan[2]), sq(plan[2], plan[0])];
+    let sum: f64 = s.iter().sum();
+    let sum_sq: f64 = s.iter().map(|a| a * a).sum();
+    (sum / (48.0 * f), (sum * sum + sum_sq) / (2880.0 * f * f))
+}
+
+fn relative(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+#[test]
+fn equilateral_facet_on_the_paraboloid_has_design_estimate_as_axial_facet_rms() {
+    let p = design(3.0);
+    let side = 0.7;
+    // Anywhere on the paraboloid: the axial deviation depends on the facet only.
+    for corner in [[0.0, 0.0], [2.0, -1.0], [-5.0, 4.0]] {
+        let plan = [
+            corner,
+            [corner[0] + side, corner[1]],
+            [corner[0] + 0.5 * side, corner[1] + 0.75f64.sqrt() * side],
+        ];
+        let nodes = plan.map(|c| on(&p, c));
+        let rms = facet_rms(&p, &nodes, &[[0, 1, 2]]).unwrap();
+        let exact = side * side / (4.0 * 15f64.sqrt() * p.focal_length_m);
+        assert!(relative(rms.axial_m, exact) <= 1e-13, "{rms:?} vs {exact}");
+        // Normal and half path: the axial deviation scaled by cos α and cos² α,
+        // which lie between their values at the facet's nearest and farthest
+        // corner from the axis (cos α falls with r).
+        let cos = |c: [f64; 2]| {
+            let f2 = 4.0 * p.focal_length_m.powi(2);
+            (f2 / (f2 + c[0] * c[0] + c[1] * c[1])).sqrt()
+        };
+        let (lo, hi) = plan
+            .iter()
+            .map(|&c| cos(c))
+            .fold((1.0f64, 0.0f64), |(lo, hi), c| (lo.min(c), hi.max(c)));
+        // A facet touching the axis has its largest cos α inside, 1.
+        let hi = if corner == [0.0, 0.0] { 1.0 } else { hi };
+        assert!(rms.normal_m >= lo * exact && rms.normal_m <= hi * exact, "{rms:?}");
+        assert!(
+            rms.half_path_m >= lo * lo * exact && rms.half_path_m <= hi * hi * exact,
+            "{rms:?}"
+        );
+    }
+}
+
+#[test]
+fn any_facet_with_corners_on_the_paraboloid_has_the_closed_form_facet_rms() {
+    let p = design(4.0);
+    let plan = [[1.0, 2.0], [3.7, 1.1], [2.2, 4.9]];
+    let nodes = plan.map(|c| on(&p, c));
+    let rms = facet_rms(&p, &nodes, &[[0, 1, 2]]).unwrap();
+    let (_, mean_square) = bubble_moments(plan, p.focal_length_m);
+    assert!(relative(rms.axial_m, mean_square.sqrt()) <= 1e-13, "{rms:?}");
+    // The orientation of a facet does not matter.
+    let flipped = facet_rms(&p, &nodes, &[[0, 2, 1]]).unwrap();
+    assert!(relative(flipped.axial_m, rms.axial_m) <= 1e-13);
+}
+
+#[test]
+fn lifted_facet_measures_its_lift() {
+    // Under a flat paraboloid (F → ∞) a facet lifted by h deviates by h
+    // everywhere, along the axis, the normal and the path alike.
+    let flat = design(1e30);
+    let h = 2.5e-3;
+    let nodes = [[0.0, 0.0, h], [1.0, 0.0, h], [0.0, 1.0, h], [1.0, 1.0, h]];
+    let rms = facet_rms(&flat, &nodes, &[[0, 1, 2], [1, 3, 2]]).unwrap();
+    for v in [rms.axial_m, rms.normal_m, rms.half_path_m] {
+        assert!((v - h).abs() <= 1e-17, "{rms:?}");
+    }
+    // On a curved paraboloid the lift adds to the facet's bubble:
+    // mean square h² + 2h·mean + mean square of the bubble.
+    let p = design(2.0);
+    let plan = [[0.5, 0.5], [1.5, 0.2], [1.0, 1.4]];
+    let nodes = plan.map(|c| {
+        let [x, y, z] = on(&p, c);
+        [x, y, z + h]
+    });
+    let rms = facet_rms(&p, &nodes, &[[0, 1, 2]]).unwrap();
+    let (mean, mean_square) = bubble_moments(plan, p.focal_length_m);
+    let exact = (h * h + 2.0 * h * mean + mean_square).sqrt();
+    assert!(relative(rms.axial_m, exact) <= 1e-13, "{} vs {exact}", rms.axial_m);
+}
+
+#[test]
+fn node_rms_of_lifted_nodes_is_the_lift_seen_along_the_normal_and_the_path() {
+    let p = design(5.0);
+    let h = -1e-3;
+    let plan = [[0.0, 0.0], [3.0, 0.0], [0.0, 10.0], [-4.0, -4.0]];
+    let nodes: Vec<[f64; 3]> = plan
+        .iter()
+        .map(|&c| {
+            let [x, y, z] = on(&p, c);
+            [x, y, z + h]
+        })
+        .collect();
+    let rms = node_rms(&p, &nodes).unwrap();
+    let cos2: Vec<f64> = plan
+        .iter()
+        .map(|c| 100.0 / (100.0 + c[0] * c[0] + c[1] * c[1]))
+        .collect();
+    let mean = |f: &dyn Fn(f64) -> f64| cos2.iter().map(|&c| f(c)).sum::<f64>() / 4.0;
+    assert!(relative(rms.axial_m, h.abs()) <= 1e-12);
+    assert!(relative(rms.normal_m, h.abs() * mean(&|c| c).sqrt()) <= 1e-12);
+    assert!(relative(rms.half_path_m, h.abs() * mean(&|c| c * c).sqrt()) <= 1e-12);
+}
+
+/// Each facet cut into m² congruent triangles, sampled at their centroids
+/// (independent of the quadrature rule; error O(1/m²)).
+fn brute_force(p: &Paraboloid, net: &FacetNet, m: usize) -> SurfaceRms {
+    let placed = PlacedParaboloid::design(p);
+    let (mut area, mut sums) = (0.0, [0.0; 3]);
+    let mut sample = |l1: f64, l2: f64, c: [[f64; 3]; 3], w: f64| {
+        let x = std::array::from_fn(|d| (1.0 - l1 - l2) * c[0][d] + l1 * c[1][d] + l2 * c[2][d]);
+        let d = placed.deviation(x);
+        for (s, v) in sums.iter_mut().zip([d.axial_m, d.normal_m, d.half_path_m]) {
+            *s += w * v * v;
+        }
+    };
+    let n = m as f64;
+    for t in &net.triangles {
+        let c = t.map(|i| net.nodes_m[i]);
+        let a = plan_area_m2(c[0], c[1], c[2]);
+        let w = a / (n * n);
+        for i in 0..m {
+            for j in 0..m - i {
+                let (fi, fj) = (i as f64, j as f64);
+                sample((fi + 1.0 / 3.0) / n, (fj + 1.0 / 3.0) / n, c, w);
+                if i + j + 1 < m {
+                    sample((fi + 2.0 / 3.0) / n, (fj + 2.0 / 3.0) / n, c, w);
+                }
+            }
+        }
+        area += a;
+    }
+    SurfaceRms {
+        axial_m: (sums[0] / area).sqrt(),
+        normal_m: (sums[1] / area).sqrt(),
+        half_path_m: (sums[2] / area).sqrt(),
+    }
+}
+
+#[test]
+fn facet_rms_of_a_net_equals_brute_force_sampling_of_its_facets() {
+    // paper-26m's 4-ring front net: facets 3.3 m long on F = 4 m, as large
+    // against F as the crate generates; nodes moved off the surface by up to
+    // 5 mm so the deviation is more than the facets' bubbles.
+    let s = scene("problems/paper-26m.toml");
+    let p = design(s.reflector.focal_length_m);
+    let mut net = front_net(&s, 4);
+    for (i, x) in net.nodes_m.iter_mut().enumerate() {
+        x[2] += 5e-3 * (1.7 * i as f64).sin();
+    }
+    let rms = facet_rms(&p, &net.nodes_m, &net.triangles).unwrap();
+    // Richardson on the centroid rule's 1/m² error, from 100² and 200²
+    // samples a facet.
+    let (coarse, fine) = (brute_force(&p, &net, 100), brute_force(&p, &net, 200));
+    let extrapolate = |c: f64, f: f64| ((4.0 * f * f - c * c) / 3.0).sqrt();
+    for (name, got, c, f) in [
+        ("axial", rms.axial_m, coarse.axial_m, fine.axial_m),
+        ("normal", rms.normal_m, coarse.normal_m, fine.normal_m),
+        ("half path", rms.half_path_m, coarse.half_path_m, fine.half_path_m),
+    ] {
+        let brute = extrapolate(c, f);
+        assert!(
+            relative(got, brute) <= 1e-6,
+            "{name}: {got} vs brute force {brute} (100²: {c}, 200²: {f})"
+        );
+    }
+}
