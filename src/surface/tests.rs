@@ -186,7 +186,7 @@ fn facet_rms_of_a_net_equals_brute_force_sampling_of_its_facets() {
     }
     let rms = facet_rms(&p, &net.nodes_m, &net.triangles).unwrap();
     // Richardson on the centroid rule's 1/m² error, from 100² and 200²
-    // samples a facet.
+    // samples a facet: the brute force is then good to O(1/m⁴) ≈ 1e-9.
     let (coarse, fine) = (brute_force(&p, &net, 100), brute_force(&p, &net, 200));
     let extrapolate = |c: f64, f: f64| ((4.0 * f * f - c * c) / 3.0).sqrt();
     for (name, got, c, f) in [
@@ -196,8 +196,126 @@ fn facet_rms_of_a_net_equals_brute_force_sampling_of_its_facets() {
     ] {
         let brute = extrapolate(c, f);
         assert!(
-            relative(got, brute) <= 1e-6,
+            relative(got, brute) <= 1e-8,
             "{name}: {got} vs brute force {brute} (100²: {c}, 200²: {f})"
         );
     }
+}
+
+/// Nodes on `placed` above a plan grid of its own frame (a disc of radius
+/// `radius_m`, not one circle).
+fn nodes_on(placed: &PlacedParaboloid, radius_m: f64) -> Vec<[f64; 3]> {
+    let mut nodes = Vec::new();
+    for i in -8..=8 {
+        for j in -8..=8 {
+            let (x, y) = (i as f64 * radius_m / 8.0, j as f64 * radius_m / 8.0);
+            if x * x + y * y <= radius_m * radius_m {
+                nodes.push(placed.surface_point_m(x, y));
+            }
+        }
+    }
+    nodes
+}
+
+#[test]
+fn nodes_on_a_refocused_paraboloid_fit_it_exactly() {
+    let p = design(36.0);
+    let refocused = PlacedParaboloid {
+        focal_length_m: 36.0 * 1.001,
+        ..PlacedParaboloid::design(&p)
+    };
+    let nodes = nodes_on(&refocused, 30.0);
+    let raw = node_rms(&p, &nodes).unwrap();
+    let fit = best_fit_nodes(&p, &nodes).unwrap();
+    assert!(raw.half_path_m > 1e-3, "{raw:?}");
+    for which in [Deviation::Axial, Deviation::Normal, Deviation::HalfPathLength] {
+        assert!(
+            fit.rms.get(which) <= 1e-9 * raw.get(which),
+            "{which:?}: {} about the fit, {} raw",
+            fit.rms.get(which),
+            raw.get(which)
+        );
+    }
+    let f = fit.paraboloid;
+    assert!(relative(f.focal_length_m, refocused.focal_length_m) <= 1e-12, "{f:?}");
+    assert!(f.apex_m.iter().all(|a| a.abs() <= 1e-11), "{f:?}");
+    assert!(f.rotation_about_x_rad.abs() <= 1e-12 && f.rotation_about_y_rad.abs() <= 1e-12);
+    assert!(fit.iterations >= 1 && fit.iterations <= 10, "{}", fit.iterations);
+}
+
+#[test]
+fn nodes_on_a_moved_and_tilted_copy_of_the_design_fit_it_exactly() {
+    for (f, radius) in [(4.0, 13.0), (36.0, 30.0)] {
+        let p = design(f);
+        let moved = PlacedParaboloid {
+            apex_m: [0.012, -0.007, 0.02],
+            rotation_about_x_rad: 1.5e-3,
+            rotation_about_y_rad: -2e-3,
+            focal_length_m: f,
+        };
+        let nodes = nodes_on(&moved, radius);
+        let raw = node_rms(&p, &nodes).unwrap();
+        let fit = best_fit_nodes(&p, &nodes).unwrap();
+        for which in [Deviation::Axial, Deviation::Normal, Deviation::HalfPathLength] {
+            assert!(
+                fit.rms.get(which) <= 1e-9 * raw.get(which),
+                "F {f}, {which:?}: {} about the fit, {} raw",
+                fit.rms.get(which),
+                raw.get(which)
+            );
+        }
+        let got = fit.paraboloid;
+        for d in 0..3 {
+            assert!((got.apex_m[d] - moved.apex_m[d]).abs() <= 1e-11, "F {f}: {got:?}");
+        }
+        assert!((got.rotation_about_x_rad - moved.rotation_about_x_rad).abs() <= 1e-12);
+        assert!((got.rotation_about_y_rad - moved.rotation_about_y_rad).abs() <= 1e-12);
+        assert!(relative(got.focal_length_m, f) <= 1e-12, "F {f}: {got:?}");
+    }
+}
+
+/// `x` turned by `turn_rad` about the z axis and moved by `shift_m`: a
+/// motion that keeps every facet's plan area.
+fn plan_motion(x: [f64; 3], turn_rad: f64, shift_m: [f64; 3]) -> [f64; 3] {
+    let (s, c) = turn_rad.sin_cos();
+    [
+        c * x[0] - s * x[1] + shift_m[0],
+        s * x[0] + c * x[1] + shift_m[1],
+        x[2] + shift_m[2],
+    ]
+}
+
+#[test]
+fn best_fit_facet_rms_moves_with_the_net() {
+    // A motion that keeps the facets' plan areas (their weights) moves the
+    // best-fit paraboloid with the net and leaves the RMS about it unchanged.
+    let s = scene("problems/super-60m.toml");
+    let p = design(s.reflector.focal_length_m);
+    let mut net = front_net(&s, 10);
+    for (i, x) in net.nodes_m.iter_mut().enumerate() {
+        x[2] += 2e-3 * (0.37 * i as f64).cos();
+    }
+    let (turn, shift) = (0.3, [0.05, 0.02, -0.03]);
+    let moved: Vec<[f64; 3]> = net.nodes_m.iter().map(|&x| plan_motion(x, turn, shift)).collect();
+    let fit = best_fit_facets(&p, &net.nodes_m, &net.triangles).unwrap();
+    let fit_moved = best_fit_facets(&p, &moved, &net.triangles).unwrap();
+    for which in [Deviation::Axial, Deviation::Normal, Deviation::HalfPathLength] {
+        assert!(
+            relative(fit_moved.rms.get(which), fit.rms.get(which)) <= 1e-9,
+            "{which:?}: {:?} vs {:?}",
+            fit_moved.rms,
+            fit.rms
+        );
+    }
+    let focus = plan_motion(fit.paraboloid.focus_m(), turn, shift);
+    let axis = plan_motion(fit.paraboloid.axis(), turn, [0.0; 3]);
+    let (focus_moved, axis_moved) = (fit_moved.paraboloid.focus_m(), fit_moved.paraboloid.axis());
+    for d in 0..3 {
+        assert!((focus[d] - focus_moved[d]).abs() <= 1e-9, "{focus:?} vs {focus_moved:?}");
+        assert!((axis[d] - axis_moved[d]).abs() <= 1e-11, "{axis:?} vs {axis_moved:?}");
+    }
+    assert!(relative(fit_moved.paraboloid.focal_length_m, fit.paraboloid.focal_length_m) <= 1e-10);
+    // The fit does better than the design paraboloid on what it minimises.
+    let raw = facet_rms(&p, &net.nodes_m, &net.triangles).unwrap();
+    assert!(fit.rms.half_path_m < raw.half_path_m, "{:?} vs {raw:?}", fit.rms);
 }
