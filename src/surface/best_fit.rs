@@ -179,12 +179,10 @@ fn solve_normal(n: &[[f64; 6]; 6], b: &[f64; 6]) -> Option<[f64; 6]> {
     let mut l = [[0.0; 6]; 6];
     for i in 0..6 {
         for j in 0..=i {
-            let mut v = n[i][j] * scale[i] * scale[j];
-            for k in 0..j {
-                v -= l[i][k] * l[j][k];
-            }
+            let v = n[i][j] * scale[i] * scale[j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
             if i == j {
-                if !(v > PIVOT_TOLERANCE) {
+                // NaN fails too.
+                if v.is_nan() || v <= PIVOT_TOLERANCE {
                     return None;
                 }
                 l[i][i] = v.sqrt();
@@ -222,24 +220,20 @@ fn fit(paraboloid: &Paraboloid, samples: &Samples) -> Result<BestFit, SurfaceErr
             return done(&x, iteration - 1);
         }
         // Normal equations of the weighted least squares, per unit weight.
-        let (mut n, mut b, mut weight) = ([[0.0; 6]; 6], [0.0; 6], 0.0);
+        let (mut lower, mut b, mut weight) = ([[0.0; 6]; 6], [0.0; 6], 0.0);
         samples.for_each(|p, w| {
             let (g, grad) = residual_and_gradient(&x, p);
             weight += w;
             for i in 0..6 {
                 b[i] -= w * g * grad[i];
                 for j in 0..=i {
-                    n[i][j] += w * grad[i] * grad[j];
+                    lower[i][j] += w * grad[i] * grad[j];
                 }
             }
         });
-        for i in 0..6 {
-            b[i] /= weight;
-            for j in 0..=i {
-                n[i][j] /= weight;
-                n[j][i] = n[i][j];
-            }
-        }
+        b.iter_mut().for_each(|v| *v /= weight);
+        let n: [[f64; 6]; 6] =
+            std::array::from_fn(|i| std::array::from_fn(|j| lower[i.max(j)][i.min(j)] / weight));
         let step = solve_normal(&n, &b).ok_or(SurfaceError::FitDegenerate {
             n_samples: samples.len(),
         })?;
@@ -292,7 +286,9 @@ mod tests {
 
     fn some_points() -> Vec<[f64; 3]> {
         // A plan grid over a 10 m disc, off the surface by a few millimetres.
-        let p = Paraboloid { focal_length_m: 6.0 };
+        let p = Paraboloid {
+            focal_length_m: 6.0,
+        };
         let mut points = Vec::new();
         for i in -5..=5 {
             for j in -5..=5 {
@@ -330,7 +326,9 @@ mod tests {
 
     #[test]
     fn best_fit_is_a_minimum_of_the_half_path_error() {
-        let p = Paraboloid { focal_length_m: 6.0 };
+        let p = Paraboloid {
+            focal_length_m: 6.0,
+        };
         let points = some_points();
         let samples = Samples::nodes(&points).unwrap();
         let fit = best_fit_nodes(&p, &points).unwrap();
@@ -358,10 +356,12 @@ mod tests {
     fn points_on_one_circle_do_not_determine_a_paraboloid() {
         // On a circle about the axis, an apex lift and a focal length change
         // move every point alike.
-        let p = Paraboloid { focal_length_m: 3.0 };
+        let p = Paraboloid {
+            focal_length_m: 3.0,
+        };
         let ring: Vec<[f64; 3]> = (0..12)
             .map(|k| {
-                let (s, c) = (k as f64 * 0.5236).sin_cos();
+                let (s, c) = (k as f64 * std::f64::consts::FRAC_PI_6).sin_cos();
                 [2.0 * c, 2.0 * s, 1.0 / 3.0 + 1e-3]
             })
             .collect();

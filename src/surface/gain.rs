@@ -26,7 +26,8 @@ fn check(half_path_rms_m: f64, frequency_hz: f64) -> Result<(), SurfaceError> {
 /// `ε` negative or not finite, a frequency that is not positive.
 pub fn ruze_gain_ratio(half_path_rms_m: f64, frequency_hz: f64) -> Result<f64, SurfaceError> {
     check(half_path_rms_m, frequency_hz)?;
-    let phase = 4.0 * std::f64::consts::PI * half_path_rms_m * frequency_hz / SPEED_OF_LIGHT_M_PER_S;
+    let phase =
+        4.0 * std::f64::consts::PI * half_path_rms_m * frequency_hz / SPEED_OF_LIGHT_M_PER_S;
     Ok((-phase * phase).exp())
 }
 
@@ -37,7 +38,8 @@ pub fn ruze_gain_ratio(half_path_rms_m: f64, frequency_hz: f64) -> Result<f64, S
 /// As [`ruze_gain_ratio`].
 pub fn ruze_gain_loss_db(half_path_rms_m: f64, frequency_hz: f64) -> Result<f64, SurfaceError> {
     check(half_path_rms_m, frequency_hz)?;
-    let phase = 4.0 * std::f64::consts::PI * half_path_rms_m * frequency_hz / SPEED_OF_LIGHT_M_PER_S;
+    let phase =
+        4.0 * std::f64::consts::PI * half_path_rms_m * frequency_hz / SPEED_OF_LIGHT_M_PER_S;
     Ok(10.0 / std::f64::consts::LN_10 * phase * phase)
 }
 
@@ -54,11 +56,17 @@ mod tests {
         let ratio = ruze_gain_ratio(eps, f).unwrap();
         assert!((ratio - (-1.0f64).exp()).abs() < 1e-15, "{ratio}");
         let loss = ruze_gain_loss_db(eps, f).unwrap();
-        assert!((loss - 10.0 * std::f64::consts::E.log10()).abs() < 1e-13, "{loss}");
+        assert!(
+            (loss - 10.0 * std::f64::consts::E.log10()).abs() < 1e-13,
+            "{loss}"
+        );
         // ε = λ/16: (π/4)² = 0.617 of a neper, 2.68 dB.
         let loss = ruze_gain_loss_db(lambda / 16.0, f).unwrap();
         let expected = -10.0 * (-(std::f64::consts::PI / 4.0).powi(2)).exp().log10();
-        assert!((loss - expected).abs() < 1e-13 && (loss - 2.68).abs() < 5e-3, "{loss}");
+        assert!(
+            (loss - expected).abs() < 1e-13 && (loss - 2.68).abs() < 5e-3,
+            "{loss}"
+        );
         // Quadratic in ε and in f, and the two functions agree.
         let (e, g) = (1.5e-3, 8.4e9);
         let l1 = ruze_gain_loss_db(e, g).unwrap();

@@ -24,19 +24,19 @@
 //! only the best fit removes it).
 //!
 //! **Why the half path length.** A ray parallel to the axis meets the
-//! paraboloid at plan radius `r` and reflects to the focus; at the focus it
-//! makes the angle `ψ` with the axis (towards the apex), and `r = 2F tan(ψ/2)`.
-//! The surface slope there is `tan α = dz/dr = r/(2F)`, so `α = ψ/2`: the
-//! angle of incidence on the surface is `ψ/2`. Displacing the surface by `δn`
-//! along its normal shortens the path to the focus by `2 δn cos(ψ/2)` (the two
-//! legs, each by the normal offset over the cosine of incidence, less the
-//! sideways shift; the reflected direction's own change is second order, by
-//! Fermat). An axial displacement `δz` is `δn = δz cos α` normal to the
-//! surface (the tangential part moves the surface along itself), so the path
-//! changes by `2 δz cos² α` and the half path length by
-//! `ε = δz cos² α = δz · 4F²/(4F² + r²)`. Ruze's `ε` is its RMS over the
-//! aperture — the plan-area-weighted facet RMS of `ε`, for uniform
-//! illumination.
+//! paraboloid at plan radius `r` and reflects to the focus, where it makes the
+//! angle `ψ` with the axis: `r = 2F tan(ψ/2)`. The surface slope there is
+//! `tan α = r/(2F)`, so `α = ψ/2`, and the ray meets the surface at incidence
+//! `ψ/2`. Moving the surface by `δn` along its normal, towards the focus,
+//! shortens the ray's path by `2 δn cos(ψ/2)`, as between two parallel mirrors
+//! `δn` apart (to first order: by Fermat the path is stationary in the
+//! reflected ray's direction, so its turn does not count). An axial
+//! displacement `δz` is `δn = δz cos α` along the normal (its tangential part
+//! slides the surface along itself), so the path changes by `2 δz cos² α`
+//! and the half path length by `ε = δz · 4F²/(4F² + r²)`. A unit test checks
+//! this against the exact path from a plane across the beam to the focus.
+//! Ruze's `ε` is its RMS over the aperture: the plan-area-weighted facet RMS
+//! of `ε`, for uniform illumination.
 //!
 //! **Facet RMS and DESIGN §12.** With its corners on the paraboloid, a flat
 //! facet of squared plan sides `a, b, c` has the axial facet RMS

@@ -139,7 +139,10 @@ mod tests {
         }
         let point = p.surface_point_m(1.5, -2.0);
         let q = p.to_local(point);
-        assert!((q[0] - 1.5).abs() < 1e-14 && (q[1] + 2.0).abs() < 1e-14, "{q:?}");
+        assert!(
+            (q[0] - 1.5).abs() < 1e-14 && (q[1] + 2.0).abs() < 1e-14,
+            "{q:?}"
+        );
         assert!(p.deviation(point).axial_m.abs() < 1e-14);
     }
 

@@ -115,7 +115,10 @@ mod tests {
             // than stated, so the claim above is the rule's, not luck's).
             let d = rule.degree() + 1;
             let (got, exact) = (mean(d as i32, 0), monomial_mean(d, 0));
-            assert!((got - exact).abs() > 1e-9 * exact, "n {n}: {got} vs {exact}");
+            assert!(
+                (got - exact).abs() > 1e-9 * exact,
+                "n {n}: {got} vs {exact}"
+            );
         }
     }
 }
