@@ -44,9 +44,10 @@
 //! an equilateral facet of side `L` that is §12's `L²/(4√15 F)`; the crate's
 //! sector nets have thin isosceles facets (two sides `R/rings`, one
 //! `chord/rings`), which give about `1/√2` of §12's figure with
-//! `L = R/rings` (super-60m: 1.5 mm against 2.1 mm). About the best fit,
-//! equilateral facets lose the mean `L²/(16F)` of their bubble and their
-//! facet RMS falls 4× (§12); thin isosceles facets only ≈ 2.4×.
+//! `L = R/rings` (super-60m: 1.41 mm, 1.47 mm without the boundary sag,
+//! against 2.06 mm). About the best fit a net of like facets loses their mean
+//! bubble `(a + b + c)/(48F)` to the apex: equilateral facets' RMS falls 4×
+//! (§12's figure), the sector nets' thin isosceles ones only ≈ 2.5×.
 
 mod best_fit;
 mod error;
