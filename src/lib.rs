@@ -15,6 +15,9 @@
 //! * [`scene`] — the problem file (TOML), validated once into a [`Scene`];
 //! * [`geometry`] — the paraboloid, the ring-truss layout and the net generators,
 //!   which turn a scene into a cable [`Network`];
+//! * [`surface`] — surface accuracy: node, facet and best-fit RMS about the
+//!   paraboloid, the half-path-length error and Ruze's gain loss, the net for a
+//!   facet RMS target;
 //! * [`network`] — nodes, cables, groups, the fixed/free split and the
 //!   interchange JSON format;
 //! * [`fdm`] — the force density method: forward equilibrium, reactions, the
@@ -53,6 +56,7 @@ pub mod shard;
 pub mod sizing;
 pub mod status;
 pub mod study;
+pub mod surface;
 pub mod truss;
 pub mod uniformity;
 pub mod verify;
@@ -104,6 +108,9 @@ pub enum Error {
     /// A workload beyond the memory limit.
     #[error(transparent)]
     Memory(#[from] resources::MemoryError),
+    /// A surface that cannot be measured, or a net target no net meets.
+    #[error(transparent)]
+    Surface(#[from] surface::SurfaceError),
 }
 
 impl From<truss::SceneResponseError> for Error {
@@ -131,6 +138,7 @@ impl Error {
             Error::Study(e) => e.is_bad_input(),
             Error::Shard(e) => e.is_bad_input(),
             Error::Sizing(e) => e.is_bad_input(),
+            Error::Surface(e) => e.is_bad_input(),
             Error::Verify(e) => e.is_bad_input(),
         }
     }

@@ -585,10 +585,9 @@ fn the_guard_follows_a_module_imported_by_name() {
 /// The top-level modules in the order of docs/ARCHITECTURE.md's layer table
 /// (its first column's names, `a.rs`/`a/` → `a`), lowest first.
 fn documented_layers() -> Vec<String> {
-    let doc = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ARCHITECTURE.md"),
-    )
-    .unwrap();
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ARCHITECTURE.md"))
+            .unwrap();
     let table = doc
         .split("## Layers")
         .nth(1)
@@ -637,6 +636,9 @@ fn every_module_uses_only_the_layers_the_architecture_lists_below_it() {
             }
         }
     }
-    assert!(unlisted.is_empty(), "modules the table does not list: {unlisted:?}");
+    assert!(
+        unlisted.is_empty(),
+        "modules the table does not list: {unlisted:?}"
+    );
     assert!(upward.is_empty(), "uses of a higher layer: {upward:#?}");
 }
