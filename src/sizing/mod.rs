@@ -35,7 +35,7 @@ use serde::Serialize;
 pub use catalogue::TubeSection;
 pub use error::SizingError;
 
-use crate::design::{DesignError, DesignRun, DesignSettings};
+use crate::design::{DesignError, DesignRun, DesignSettings, LoopSummary};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::LimitBound;
 #[cfg(doc)]
@@ -69,10 +69,10 @@ pub struct SectionTrial {
     pub margin: f64,
     /// What bounds the limit load from above, when the margin was searched.
     pub bound: Option<LimitBound>,
-    /// How the outer loop ended, when it ran to the end.
-    pub termination: Option<Termination>,
-    /// Outer iterations.
-    pub outer_iterations: usize,
+    /// How the design's outer loop ended, its iterations, final residual
+    /// and wall time, when it ran to the end. Not flattened: its `time_s`
+    /// (the loop's) would collide with the trial's (the whole design's).
+    pub summary: Option<LoopSummary>,
     /// Surface RMS of the design as built (assembled), mm.
     pub rms_mm: Option<f64>,
     /// Wall time of the design, s.
@@ -214,8 +214,7 @@ impl Search<'_> {
             mass_kg,
             margin: 0.0,
             bound: None,
-            termination: None,
-            outer_iterations: 0,
+            summary: None,
             rms_mm: None,
             time_s,
             carries: false,
@@ -228,11 +227,11 @@ impl Search<'_> {
                 let limit = report.limit_margin.as_ref();
                 trial.margin = limit.map_or(0.0, |m| m.stable_to);
                 trial.bound = limit.map(|m| m.bound);
-                trial.termination = Some(report.termination);
-                trial.outer_iterations = report.outer_iterations;
+                let summary = report.design_summary();
+                trial.summary = Some(summary);
                 trial.rms_mm = Some(report.verification.rms_mm);
                 trial.carries =
-                    report.termination == Termination::Converged && trial.margin >= self.margin;
+                    summary.termination == Termination::Converged && trial.margin >= self.margin;
                 run = Some(r);
             }
             Err(e) => match truss_failure(&e) {
