@@ -30,6 +30,7 @@ mod error;
 
 use std::time::Instant;
 
+use clap::ValueEnum;
 use serde::Serialize;
 
 pub use catalogue::TubeSection;
@@ -42,7 +43,7 @@ use crate::mechanics::LimitBound;
 use crate::mechanics::LimitSearch;
 use crate::scene::{Scene, TrussModel};
 use crate::status::Termination;
-use crate::truss::{TrussError, MARGIN_SEARCH_TO as SEARCH_TO};
+use crate::truss::{self, TrussError, MARGIN_SEARCH_TO as SEARCH_TO};
 
 /// Where the sections come from.
 #[derive(Debug, Clone)]
@@ -112,12 +113,14 @@ const MARGIN_SLACK: f64 = 0.03;
 const MAX_DESIGNS: usize = 16;
 
 /// The lightest section of `sections` on which `scene`'s design (with
-/// `settings`, on the exact truss) has a limit margin of at least `margin`;
+/// `settings`, on a truss model with a limit load,
+/// [`truss::has_limit_load`]) has a limit margin of at least `margin`;
 /// `observe` sees each section tried.
 ///
 /// # Errors
 /// A margin outside `[1, SEARCH_TO]`, a scene whose truss is measured rod
-/// by rod (`effects.rod_properties_csv`) or not exact, an invalid section,
+/// by rod (`effects.rod_properties_csv`) or on a model without a limit
+/// load, an invalid section,
 /// a design that fails for another reason than its truss (no tube would
 /// help), or no section that carries ([`SizingError::NoSection`]).
 pub fn size_truss(
@@ -140,10 +143,24 @@ pub fn size_truss(
                 .into(),
         });
     }
-    if settings.truss.unwrap_or(scene.effects.truss) != TrussModel::Exact {
+    let model = settings.truss.unwrap_or(scene.effects.truss);
+    if !truss::has_limit_load(model) {
+        let name = |m: &TrussModel| {
+            m.to_possible_value()
+                .map_or_else(|| format!("{m:?}"), |v| v.get_name().to_owned())
+        };
+        let with: Vec<String> = truss::MODELS
+            .iter()
+            .filter(|m| truss::has_limit_load(**m))
+            .map(name)
+            .collect();
         return Err(SizingError::Scene {
             key: "effects.truss",
-            reason: "sizing needs the exact truss: only it has a limit load".into(),
+            reason: format!(
+                "sizing needs a truss model with a limit load ({}); the {} truss has none",
+                with.join(", "),
+                name(&model)
+            ),
         });
     }
     let mut search = Search {
