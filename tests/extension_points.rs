@@ -1,6 +1,8 @@
 //! The extension points of docs/ARCHITECTURE.md, used from outside the
 //! library: a relaxation policy and an effect, each defined in one place in
-//! this file, run through the outer design loop without touching the crate.
+//! this file, run through the outer design loop without touching the crate;
+//! and the truss models' registry, which the study and sizing ask rather
+//! than list models themselves.
 
 mod common;
 
@@ -10,6 +12,7 @@ use ringmesh::design::{
 use ringmesh::effects::{Effect, SceneEffects};
 use ringmesh::network::CableGroup;
 use ringmesh::scene::TrussModel;
+use ringmesh::study::StudySettings;
 use ringmesh::truss::{self, layout_points};
 use ringmesh::uniformity::SolverKind;
 use ringmesh::Termination;
@@ -173,4 +176,36 @@ fn an_effect_defined_outside_the_crate_acts_on_the_nets_and_the_loop() {
         design.max_residual_n,
         design.max_tension_n
     );
+}
+
+/// The registry lists every truss model a scene can name, and the study
+/// sweeps that list: a variant added to `TrussModel` without its place in
+/// `truss::MODELS` fails here. Every model listed builds its oracle, and a
+/// model sizing may use (one with a limit load) deforms.
+#[test]
+fn the_registry_lists_every_truss_model_and_the_study_sweeps_them_all() {
+    let variants = <TrussModel as clap::ValueEnum>::value_variants();
+    assert_eq!(
+        truss::MODELS,
+        variants,
+        "truss::MODELS must list every TrussModel variant, in declaration order"
+    );
+    let (scene, mesh, _) = common::small_hex_nets();
+    assert_eq!(StudySettings::for_scene(&scene).truss_models, variants);
+
+    let effects = SceneEffects::of(&scene);
+    for &model in truss::MODELS {
+        let oracle = truss::oracle(model, &scene, &mesh.truss, &effects).unwrap();
+        if truss::has_limit_load(model) {
+            assert!(
+                oracle.deforms(),
+                "{model:?} has a limit load but does not deform"
+            );
+        }
+    }
+    assert!(
+        truss::MODELS.iter().any(|&m| truss::has_limit_load(m)),
+        "sizing needs a model with a limit load"
+    );
+    assert!(!truss::has_limit_load(TrussModel::Rigid));
 }

@@ -5,8 +5,9 @@
 mod common;
 
 use ringmesh::design::{run, DesignSettings};
+use ringmesh::scene::TrussModel;
 use ringmesh::sizing::{catalogue, size_truss, Sections, TubeSection};
-use ringmesh::Scene;
+use ringmesh::{truss, Scene};
 
 /// The margin asked for.
 const MARGIN: f64 = 2.0;
@@ -133,4 +134,33 @@ fn a_margin_the_search_cannot_certify_and_a_bad_catalogue_are_refused() {
         "{stderr}"
     );
     assert!(!dir.path().join("out").exists());
+}
+
+/// Sizing asks the registry which truss models have a limit load, and
+/// refuses the others before designing anything, naming the key.
+#[test]
+fn a_truss_model_without_a_limit_load_is_refused() {
+    let scene = common::scene("small-hex");
+    let sections = Sections::Continuous { start_m: 0.05 };
+    let without: Vec<TrussModel> = truss::MODELS
+        .iter()
+        .copied()
+        .filter(|&m| !truss::has_limit_load(m))
+        .collect();
+    assert!(without.contains(&TrussModel::Linear), "{without:?}");
+    for model in without {
+        let settings = DesignSettings {
+            truss: Some(model),
+            ..DesignSettings::default()
+        };
+        let mut tried = 0;
+        let e = size_truss(&scene, &sections, MARGIN, &settings, &mut |_| tried += 1)
+            .expect_err("no limit load, no sizing");
+        let message = e.to_string();
+        assert!(
+            message.contains("effects.truss") && message.contains("limit load"),
+            "{model:?}: {message}"
+        );
+        assert_eq!(tried, 0, "{model:?}: a section was designed");
+    }
 }

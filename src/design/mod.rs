@@ -22,6 +22,8 @@
 //! * `tied_nets.rs` — the two-stage design for one boundary ([`TiedNets`]);
 //! * `outer_loop.rs` — the fixed-point iteration ([`design_loop`]);
 //! * `relaxation/` — how the next boundary is chosen;
+//! * `summary.rs` — what a run of the loop says about itself
+//!   ([`LoopSummary`]);
 //! * `pipeline.rs` — the whole job of `ringmesh design` ([`run`]): loop,
 //!   limit margin, verification by assembly, the conventional design
 //!   (the loop's iteration 0) verified on the same truss.
@@ -30,6 +32,7 @@ mod outer_loop;
 mod pipeline;
 mod relaxation;
 mod scene_nets;
+mod summary;
 mod tied_nets;
 
 pub use outer_loop::{
@@ -40,6 +43,7 @@ pub use relaxation::{
     aitken_factor, paper_step, Aitken, Anderson, Paper, Relaxation, RelaxationKind, Step,
 };
 pub use scene_nets::{default_solver, scene_problem, SceneNets};
+pub use summary::LoopSummary;
 pub use tied_nets::{TiedDesign, TiedNetSettings, TiedNets};
 
 use crate::scene::SceneError;

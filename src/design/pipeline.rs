@@ -12,6 +12,7 @@ use serde::Serialize;
 use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings};
 use super::relaxation::RelaxationKind;
 use super::scene_nets::{default_solver, SceneNets};
+use super::summary::LoopSummary;
 use super::tied_nets::TiedNetSettings;
 use super::DesignError;
 use crate::geometry::ReflectorMesh;
@@ -61,14 +62,10 @@ impl Default for DesignSettings {
 pub struct LoopRun {
     /// The policy.
     pub relaxation: RelaxationKind,
-    /// How it ended.
-    pub termination: Termination,
-    /// Outer iterations (designs made).
-    pub outer_iterations: usize,
-    /// Final `‖G(C) − C‖∞`, m.
-    pub boundary_residual_m: f64,
-    /// Wall time, s.
-    pub time_s: f64,
+    /// How it ended, its iterations, final residual and wall time (a
+    /// comparison run that failed: [`LoopSummary::failed`]).
+    #[serde(flatten)]
+    pub summary: LoopSummary,
     /// Per iteration.
     pub history: Vec<IterationRecord>,
     /// Why a comparison run stopped without a result (the truss found no
@@ -188,6 +185,20 @@ pub struct DesignReport {
     pub timings: Timings,
 }
 
+impl DesignReport {
+    /// The design loop's summary: its run, the first of `runs`.
+    ///
+    /// # Panics
+    /// If `runs` is empty ([`run`] always records the design's).
+    #[track_caller]
+    pub fn design_summary(&self) -> LoopSummary {
+        self.runs
+            .first()
+            .expect("the design's run is recorded")
+            .summary
+    }
+}
+
 /// A design run: the report and what its files are drawn from.
 #[derive(Debug)]
 pub struct DesignRun {
@@ -262,10 +273,7 @@ pub fn run(
                 }
                 runs.push(LoopRun {
                     relaxation,
-                    termination: result.termination,
-                    outer_iterations: result.history.len(),
-                    boundary_residual_m: result.boundary_residual_m(),
-                    time_s: result.time_s,
+                    summary: LoopSummary::of(&result),
                     history: result.history.clone(),
                     error: None,
                 });
@@ -274,10 +282,7 @@ pub fn run(
             // A comparison run may fail without losing the design.
             Err(e) if outcome.is_some() => runs.push(LoopRun {
                 relaxation,
-                termination: Termination::Diverged,
-                outer_iterations: history.len(),
-                boundary_residual_m: history.last().map_or(f64::NAN, |r| r.boundary_change_max_m),
-                time_s: history.last().map_or(0.0, |r| r.elapsed_s),
+                summary: LoopSummary::failed(&history),
                 history,
                 error: Some(e.to_string()),
             }),

@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use crate::design::LoopRun;
+use crate::design::{LoopRun, LoopSummary};
 use crate::network::Network;
 use crate::scene::{Cables, TrussModel};
 use crate::sizing::SectionTrial;
@@ -124,9 +124,11 @@ pub fn study_row(r: &StudyRow) -> String {
         value_name(&s.truss),
         value_name(&s.solver),
         readable(r.time_s, 5),
-        r.outer_iterations.map_or(String::new(), |n| n.to_string()),
-        r.termination.map_or(String::new(), |t| json_name(&t)),
-        g(r.boundary_residual_m),
+        r.summary
+            .map_or(String::new(), |s| s.outer_iterations.to_string()),
+        r.summary
+            .map_or(String::new(), |s| json_name(&s.termination)),
+        g(r.summary.map_or(f64::NAN, |s| s.boundary_residual_m)),
         finite(r.ratio, 11),
         finite(r.built_ratio, 11),
         g(r.ratio_error),
@@ -171,13 +173,20 @@ pub fn parse_study_row(line: &str) -> Result<StudyRow, RowError> {
         .map_err(|_| RowError::value("truss", &f[5], "truss model"))?;
     let solver = <SolverKind as clap::ValueEnum>::from_str(&f[6], false)
         .map_err(|_| RowError::value("solver", &f[6], "solver"))?;
-    let termination = if f[9].is_empty() {
-        None
-    } else {
-        Some(
-            serde_json::from_value(serde_json::Value::String(f[9].clone()))
+    // The loop's summary: its iterations and termination both, or neither
+    // (a point that failed before its loop ended). The file holds the
+    // design's time, not the loop's own.
+    let summary = match (f[8].is_empty(), f[9].is_empty()) {
+        (true, true) => None,
+        (false, false) => Some(LoopSummary {
+            termination: serde_json::from_value(serde_json::Value::String(f[9].clone()))
                 .map_err(|_| RowError::value("termination", &f[9], "termination"))?,
-        )
+            outer_iterations: whole(&f[8], "outer_iterations")?,
+            boundary_residual_m: optional(&f[10], "boundary_residual_m")?,
+            time_s: f64::NAN,
+        }),
+        (true, false) => return Err(RowError::value("outer_iterations", "", "whole number")),
+        (false, true) => return Err(RowError::value("termination", "", "termination")),
     };
     Ok(StudyRow {
         knob: Knob::from_name(&f[0]).ok_or_else(|| RowError::value("knob", &f[0], "knob"))?,
@@ -190,13 +199,7 @@ pub fn parse_study_row(line: &str) -> Result<StudyRow, RowError> {
             solver,
         },
         time_s: number(&f[7], "time_s")?,
-        outer_iterations: if f[8].is_empty() {
-            None
-        } else {
-            Some(whole(&f[8], "outer_iterations")?)
-        },
-        termination,
-        boundary_residual_m: optional(&f[10], "boundary_residual_m")?,
+        summary,
         ratio: optional(&f[11], "ratio")?,
         built_ratio: optional(&f[12], "built_ratio")?,
         ratio_error: optional(&f[13], "ratio_error")?,
@@ -321,8 +324,9 @@ pub fn sizing_csv(trials: &[SectionTrial]) -> String {
             readable(t.mass_kg, 7),
             t.margin,
             t.bound.map_or("", |b| b.kind()),
-            t.outer_iterations,
-            t.termination.map_or(String::new(), |t| json_name(&t)),
+            t.summary.map_or(0, |s| s.outer_iterations),
+            t.summary
+                .map_or(String::new(), |s| json_name(&s.termination)),
             t.rms_mm.map_or(String::new(), |v| readable(v, 7)),
             t.carries,
             t.time_s,
@@ -429,9 +433,12 @@ mod tests {
                 solver: SolverKind::LeastSquares,
             },
             time_s: 0.25,
-            outer_iterations: Some(4),
-            termination: Some(Termination::MaxIterations),
-            boundary_residual_m: 2.5e-8,
+            summary: Some(LoopSummary {
+                termination: Termination::MaxIterations,
+                outer_iterations: 4,
+                boundary_residual_m: 2.5e-8,
+                time_s: 0.125,
+            }),
             ratio: 1.25,
             built_ratio: 1.5,
             ratio_error: 0.125,
@@ -448,13 +455,36 @@ mod tests {
         assert_eq!(study_row(&back), line);
         assert_eq!(back.knob, Knob::Solver);
         assert_eq!(back.settings, row.settings);
-        assert_eq!(back.termination, row.termination);
+        let summary = back.summary.expect("the loop's summary read back");
+        assert_eq!(summary.termination, Termination::MaxIterations);
+        assert_eq!(summary.outer_iterations, 4);
+        assert_eq!(summary.boundary_residual_m, 2.5e-8);
+        assert!(
+            summary.time_s.is_nan(),
+            "the file holds the design's time only"
+        );
         assert!(back.cut_length_error_mm.is_nan());
         assert_eq!(
             back.error.as_deref(),
             Some("outer iteration 2: a \"quoted\", comma and a line")
         );
         assert_eq!(STUDY_COLUMNS.split(',').count(), 20);
+
+        // A point that failed before its loop ended: no summary, either way.
+        let failed = StudyRow {
+            summary: None,
+            ratio: f64::NAN,
+            ..row.clone()
+        };
+        let line = study_row(&failed);
+        let back = parse_study_row(&line).unwrap();
+        assert_eq!(back.summary, None);
+        assert_eq!(study_row(&back), line);
+        // Iterations without a termination is no row of ours.
+        let whole_row = study_row(&row);
+        let mut torn: Vec<&str> = whole_row.splitn(11, ',').collect();
+        torn[9] = "";
+        assert!(parse_study_row(&torn.join(",")).is_err());
     }
 
     #[test]

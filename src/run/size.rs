@@ -45,14 +45,14 @@ impl SizeOutcome {
 /// (or why it has no design), the time.
 pub fn section_line(t: &SectionTrial) -> String {
     let c = &t.section;
-    let outcome = match (&t.failure, t.rms_mm) {
-        (Some(f), _) => format!("no design: {f}"),
-        (None, Some(rms)) => format!(
+    let outcome = match (&t.failure, t.summary, t.rms_mm) {
+        (Some(f), _, _) => format!("no design: {f}"),
+        (None, Some(s), Some(rms)) => format!(
             "{} outer iterations, RMS as built {} mm",
-            t.outer_iterations,
+            s.outer_iterations,
             readable(rms, 3)
         ),
-        (None, None) => String::new(),
+        (None, _, _) => String::new(),
     };
     format!(
         "{:.1}/{:.1} mm tube: {:.0} kg, margin {:.3}{}, {}; {outcome} ({:.1} s)",

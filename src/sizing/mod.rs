@@ -30,19 +30,20 @@ mod error;
 
 use std::time::Instant;
 
+use clap::ValueEnum;
 use serde::Serialize;
 
 pub use catalogue::TubeSection;
 pub use error::SizingError;
 
-use crate::design::{DesignError, DesignRun, DesignSettings};
+use crate::design::{DesignError, DesignRun, DesignSettings, LoopSummary};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::LimitBound;
 #[cfg(doc)]
 use crate::mechanics::LimitSearch;
 use crate::scene::{Scene, TrussModel};
 use crate::status::Termination;
-use crate::truss::{TrussError, MARGIN_SEARCH_TO as SEARCH_TO};
+use crate::truss::{self, TrussError, MARGIN_SEARCH_TO as SEARCH_TO};
 
 /// Where the sections come from.
 #[derive(Debug, Clone)]
@@ -69,10 +70,10 @@ pub struct SectionTrial {
     pub margin: f64,
     /// What bounds the limit load from above, when the margin was searched.
     pub bound: Option<LimitBound>,
-    /// How the outer loop ended, when it ran to the end.
-    pub termination: Option<Termination>,
-    /// Outer iterations.
-    pub outer_iterations: usize,
+    /// How the design's outer loop ended, its iterations, final residual
+    /// and wall time, when it ran to the end. Not flattened: its `time_s`
+    /// (the loop's) would collide with the trial's (the whole design's).
+    pub summary: Option<LoopSummary>,
     /// Surface RMS of the design as built (assembled), mm.
     pub rms_mm: Option<f64>,
     /// Wall time of the design, s.
@@ -112,12 +113,14 @@ const MARGIN_SLACK: f64 = 0.03;
 const MAX_DESIGNS: usize = 16;
 
 /// The lightest section of `sections` on which `scene`'s design (with
-/// `settings`, on the exact truss) has a limit margin of at least `margin`;
+/// `settings`, on a truss model with a limit load,
+/// [`truss::has_limit_load`]) has a limit margin of at least `margin`;
 /// `observe` sees each section tried.
 ///
 /// # Errors
 /// A margin outside `[1, SEARCH_TO]`, a scene whose truss is measured rod
-/// by rod (`effects.rod_properties_csv`) or not exact, an invalid section,
+/// by rod (`effects.rod_properties_csv`) or on a model without a limit
+/// load, an invalid section,
 /// a design that fails for another reason than its truss (no tube would
 /// help), or no section that carries ([`SizingError::NoSection`]).
 pub fn size_truss(
@@ -140,10 +143,24 @@ pub fn size_truss(
                 .into(),
         });
     }
-    if settings.truss.unwrap_or(scene.effects.truss) != TrussModel::Exact {
+    let model = settings.truss.unwrap_or(scene.effects.truss);
+    if !truss::has_limit_load(model) {
+        let name = |m: &TrussModel| {
+            m.to_possible_value()
+                .map_or_else(|| format!("{m:?}"), |v| v.get_name().to_owned())
+        };
+        let with: Vec<String> = truss::MODELS
+            .iter()
+            .filter(|m| truss::has_limit_load(**m))
+            .map(name)
+            .collect();
         return Err(SizingError::Scene {
             key: "effects.truss",
-            reason: "sizing needs the exact truss: only it has a limit load".into(),
+            reason: format!(
+                "sizing needs a truss model with a limit load ({}); the {} truss has none",
+                with.join(", "),
+                name(&model)
+            ),
         });
     }
     let mut search = Search {
@@ -214,8 +231,7 @@ impl Search<'_> {
             mass_kg,
             margin: 0.0,
             bound: None,
-            termination: None,
-            outer_iterations: 0,
+            summary: None,
             rms_mm: None,
             time_s,
             carries: false,
@@ -228,11 +244,11 @@ impl Search<'_> {
                 let limit = report.limit_margin.as_ref();
                 trial.margin = limit.map_or(0.0, |m| m.stable_to);
                 trial.bound = limit.map(|m| m.bound);
-                trial.termination = Some(report.termination);
-                trial.outer_iterations = report.outer_iterations;
+                let summary = report.design_summary();
+                trial.summary = Some(summary);
                 trial.rms_mm = Some(report.verification.rms_mm);
                 trial.carries =
-                    report.termination == Termination::Converged && trial.margin >= self.margin;
+                    summary.termination == Termination::Converged && trial.margin >= self.margin;
                 run = Some(r);
             }
             Err(e) => match truss_failure(&e) {

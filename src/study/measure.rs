@@ -7,19 +7,11 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::{points, RunSettings, StudyError, StudyPoint, StudyRow, StudySettings};
-use crate::design::{LoopSettings, SceneNets};
+use crate::design::{LoopSettings, LoopSummary, SceneNets};
 use crate::scene::Scene;
 use crate::shard::Shard;
 use crate::status::Termination;
 use crate::verify::{verify, AssemblyTruss};
-
-/// What the outer loop made.
-struct LoopSummary {
-    iterations: usize,
-    termination: Termination,
-    residual_m: f64,
-    ratio: f64,
-}
 
 /// A design as built on the reference truss.
 struct Judged {
@@ -34,7 +26,9 @@ struct Judged {
 /// One point run and judged.
 struct Measurement {
     time_s: f64,
-    summary: Option<LoopSummary>,
+    /// The outer loop's summary and its design's `Tmax/Tmin`, when the loop
+    /// ended.
+    designed: Option<(LoopSummary, f64)>,
     judged: Option<Judged>,
     error: Option<String>,
 }
@@ -69,18 +63,13 @@ fn measure(
         Err(e) => {
             return Measurement {
                 time_s,
-                summary: None,
+                designed: None,
                 judged: None,
                 error: Some(e.to_string()),
             }
         }
     };
-    let summary = LoopSummary {
-        iterations: outcome.history.len(),
-        termination: outcome.termination,
-        residual_m: outcome.boundary_residual_m(),
-        ratio: outcome.design.ratio,
-    };
+    let designed = (LoopSummary::of(&outcome), outcome.design.ratio);
     let mut judge = scene.clone();
     judge.truss.elements_per_rod = judge_elements;
     let network = outcome.problem.network();
@@ -129,7 +118,7 @@ fn measure(
     };
     Measurement {
         time_s,
-        summary: Some(summary),
+        designed: Some(designed),
         judged,
         error,
     }
@@ -164,10 +153,8 @@ fn row(
         value: point.value.clone(),
         settings: point.settings,
         time_s: m.time_s,
-        outer_iterations: m.summary.as_ref().map(|s| s.iterations),
-        termination: m.summary.as_ref().map(|s| s.termination),
-        boundary_residual_m: m.summary.as_ref().map_or(nan, |s| s.residual_m),
-        ratio: m.summary.as_ref().map_or(nan, |s| s.ratio),
+        summary: m.designed.map(|(summary, _)| summary),
+        ratio: m.designed.map_or(nan, |(_, ratio)| ratio),
         built_ratio: get(|j| j.built_ratio),
         ratio_error: (get(|j| j.built_ratio) - reference.built_ratio).abs() / reference.built_ratio,
         rms_mm: get(|j| j.rms_mm),
@@ -209,12 +196,12 @@ pub fn run_study(
         settings: reference_point.settings.to_string(),
         message,
     };
-    if let Some(s) = measured.summary.as_ref() {
+    if let Some((s, _)) = measured.designed {
         if s.termination != Termination::Converged {
             return Err(failed(format!(
                 "its outer loop stopped {:?} after {} iterations (residual {:.3e} m): a \
                  yardstick must be converged",
-                s.termination, s.iterations, s.residual_m
+                s.termination, s.outer_iterations, s.boundary_residual_m
             )));
         }
     }

@@ -116,7 +116,8 @@ pub struct StudySettings {
 impl StudySettings {
     /// The default sweeps for `scene`: tolerances 1e-2 … 1e-7 m, 1, 2, 4, 8
     /// and 16 elements per rod, rings `⌈r/2⌉, r, ⌈3r/2⌉, 2r` about the
-    /// scene's `r` (at least 2), every truss model, and the solvers `lp`,
+    /// scene's `r` (at least 2), every truss model of the registry
+    /// ([`crate::truss::MODELS`]), and the solvers `lp`,
     /// `bisection`, `least-squares`, `gradient`; 50 outer iterations at most.
     pub fn for_scene(scene: &Scene) -> StudySettings {
         let r = scene.front_net.rings;
@@ -129,7 +130,7 @@ impl StudySettings {
             tolerances_m: vec![1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7],
             elements_per_rod: vec![1, 2, 4, 8, 16],
             rings,
-            truss_models: vec![TrussModel::Rigid, TrussModel::Linear, TrussModel::Exact],
+            truss_models: crate::truss::MODELS.to_vec(),
             solvers: vec![
                 SolverKind::Lp,
                 SolverKind::Bisection,

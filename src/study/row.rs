@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::{Knob, RunSettings};
-use crate::status::Termination;
+use crate::design::LoopSummary;
 
 /// One row of `accuracy-vs-time.csv`: a point, its cost and its accuracy.
 /// Missing numbers (a failed point, another net's cut lengths) are NaN.
@@ -16,14 +16,15 @@ pub struct StudyRow {
     pub value: String,
     /// The point's settings.
     pub settings: RunSettings,
-    /// Wall time of the design: mesh, problem and outer loop, s.
+    /// Wall time of the design: mesh, problem and outer loop, s (the
+    /// study's cost; measured for a failed point too).
     pub time_s: f64,
-    /// Outer iterations.
-    pub outer_iterations: Option<usize>,
-    /// How the loop ended.
-    pub termination: Option<Termination>,
-    /// Final `‖G(C) − C‖∞`, m.
-    pub boundary_residual_m: f64,
+    /// How the outer loop ended, its iterations and final residual; none
+    /// when the point failed before its loop ended. Its `time_s` is the
+    /// loop's alone: `accuracy-vs-time.csv` holds the design's (`time_s`
+    /// above), so a row read back has NaN there. Not flattened: its
+    /// `time_s` would collide with the row's.
+    pub summary: Option<LoopSummary>,
     /// The design's `Tmax/Tmin` (largest set).
     pub ratio: f64,
     /// `Tmax/Tmin` as built on the reference truss (largest set).

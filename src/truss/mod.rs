@@ -23,7 +23,7 @@ pub use builder::{RingTruss, RingTrussBuilder};
 pub use exact::ExactTruss;
 pub use linear::LinearTruss;
 pub use margin::{limit_margin, PRECISION as MARGIN_PRECISION, SEARCH_TO as MARGIN_SEARCH_TO};
-pub use registry::{oracle, oracle_on_frame};
+pub use registry::{has_limit_load, oracle, oracle_on_frame, MODELS};
 pub use response::{layout_points, TrussEquilibrium, TrussError, TrussOracle, TrussResponse};
 pub use rigid::RigidTruss;
 pub use scene_response::{

@@ -1,6 +1,9 @@
 //! The registry of truss models: the one place a [`TrussModel`] (what a scene
-//! file names) becomes a [`TrussOracle`]. A new model is its own file in
-//! this module, a variant of [`TrussModel`] and one arm here.
+//! file names) becomes a [`TrussOracle`], and the one place that lists the
+//! models ([`MODELS`], what the study sweeps) and says what each can do
+//! ([`has_limit_load`], what sizing needs). A new model is its own file in
+//! this module, a variant of [`TrussModel`], its arms here and its place in
+//! [`MODELS`] (a test fails while a variant is missing from it).
 
 use super::builder::{RingTruss, RingTrussBuilder};
 use super::exact::ExactTruss;
@@ -10,6 +13,20 @@ use super::rigid::RigidTruss;
 use crate::effects::SceneEffects;
 use crate::geometry::RingTrussLayout;
 use crate::scene::{Scene, TrussModel};
+
+/// Every truss model, in order of increasing fidelity.
+pub const MODELS: &[TrussModel] = &[TrussModel::Rigid, TrussModel::Linear, TrussModel::Exact];
+
+/// True when `model` has a limit load under the net's pull — it follows the
+/// truss's geometry as it deforms — so that a section can be sized for a
+/// margin to it ([`crate::sizing`]). A rigid truss does not deform; a linear
+/// frame's response grows without bound with the load.
+pub fn has_limit_load(model: TrussModel) -> bool {
+    match model {
+        TrussModel::Rigid | TrussModel::Linear => false,
+        TrussModel::Exact => true,
+    }
+}
 
 /// The oracle of `model` for `scene`'s truss on `layout`, with the scene's
 /// `effects`: only that model is built — a rigid scene never constructs a
