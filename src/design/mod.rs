@@ -48,6 +48,7 @@ pub use tied_nets::{TiedDesign, TiedNetSettings, TiedNets};
 
 use crate::scene::SceneError;
 use crate::status::Termination;
+use crate::surface::SurfaceError;
 use crate::truss::TrussError;
 use crate::uniformity::UniformityError;
 use crate::verify::VerifyError;
@@ -105,6 +106,9 @@ pub enum DesignError {
     /// The design cannot be assembled as built.
     #[error(transparent)]
     Verify(#[from] VerifyError),
+    /// The surface's target no net meets, or a surface that cannot be measured.
+    #[error(transparent)]
+    Surface(#[from] SurfaceError),
 }
 
 impl DesignError {
@@ -120,6 +124,7 @@ impl DesignError {
             DesignError::Scene(_) => true,
             DesignError::Problem(e) => e.is_bad_input(),
             DesignError::Verify(e) => e.is_bad_input(),
+            DesignError::Surface(e) => e.is_bad_input(),
         }
     }
 }

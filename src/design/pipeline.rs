@@ -20,6 +20,7 @@ use crate::mechanics::LimitSearch;
 use crate::network::Network;
 use crate::scene::{Scene, TrussModel};
 use crate::status::Termination;
+use crate::surface::{budget, resolve_front_rings, FrontSurface, SurfaceBudget};
 use crate::truss::{RingTruss, RingTrussBuilder, TrussError};
 use crate::uniformity::{Design, SolverKind, UniformitySet};
 use crate::verify::{verify_on_frame, Verification};
@@ -96,6 +97,8 @@ pub struct Timings {
     pub margin_s: f64,
     /// The design cut to length and assembled.
     pub verification_s: f64,
+    /// The surface error budget (facet RMS and best fits).
+    pub surface_s: f64,
     /// The conventional design (the loop's iteration 0) assembled.
     pub conventional_s: f64,
     /// Writing every file but `design.json`.
@@ -135,6 +138,7 @@ impl Timings {
             + self.comparison_loops_s
             + self.margin_s
             + self.verification_s
+            + self.surface_s
             + self.conventional_s
             + self.writing_s
     }
@@ -170,6 +174,9 @@ pub struct DesignReport {
     pub runs: Vec<LoopRun>,
     /// The design cut to length and assembled.
     pub verification: Verification,
+    /// The surface error budget of the design as built: facets, design,
+    /// total, raw and best fit, the gain loss at the scene's frequency.
+    pub surface: SurfaceBudget,
     /// The rigid-truss design assembled on the same truss (absent when the
     /// loop's truss is rigid: then it is the design itself).
     pub conventional: Option<Verification>,
@@ -232,6 +239,10 @@ pub fn run(
 ) -> Result<DesignRun, DesignError> {
     let clock = Instant::now();
     let mut timings = Timings::default();
+    // A scene that leaves its net to a surface target gets the coarsest net
+    // that meets it (the command layer has usually chosen it already).
+    let resolved = resolve_front_rings(scene)?;
+    let scene = &resolved;
     let model = settings.truss.unwrap_or(scene.effects.truss);
     let mut scene_nets = SceneNets::new(scene)?;
     scene_nets.nets = scene_nets.nets.with_settings(settings.tied_nets.clone())?;
@@ -331,6 +342,24 @@ pub fn run(
     )?;
     timings.verification_s = stage.elapsed().as_secs_f64();
     let stage = Instant::now();
+    let n_front = mesh.n_front_nodes;
+    let surface = budget(
+        &mesh.paraboloid,
+        FrontSurface {
+            designed_m: &outcome.design.nodes_xyz_m[..n_front],
+            built_m: &verification.nodes_xyz_m[..n_front],
+            free: &network.fixed_mask()[..n_front]
+                .iter()
+                .map(|fixed| !fixed)
+                .collect::<Vec<_>>(),
+            triangles: &mesh.front_triangles,
+        },
+        &scene.surface,
+        scene.front_net.rings,
+        scene.front_net.chosen.as_ref(),
+    )?;
+    timings.surface_s = stage.elapsed().as_secs_f64();
+    let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
     // undeformed attachment points, assembled from the truss's response to
     // it that the loop already solved.
@@ -362,6 +391,7 @@ pub fn run(
         history: outcome.history.clone(),
         runs,
         verification,
+        surface,
         conventional,
         limit_margin,
         boundary_m: outcome.boundary_m.clone(),

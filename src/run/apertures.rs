@@ -3,9 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::Summary;
+use super::{read_scene, Summary};
 use crate::report::{aperture_csv, aperture_plot, readable, write_atomic, write_json, OutputSet};
-use crate::scene::Scene;
 use crate::study::{run_aperture_study, value_name, ApertureResult, ApertureSettings};
 use crate::Error;
 
@@ -77,7 +76,7 @@ pub fn apertures(
     output_dir: Option<&Path>,
     observe: &mut dyn FnMut(&ApertureResult),
 ) -> Result<AperturesOutcome, Error> {
-    let scene = Scene::read(scene_path)?;
+    let scene = read_scene(scene_path)?;
     let dir = output_dir.map_or_else(
         || Path::new("results").join(&scene.name).join("apertures"),
         Path::to_path_buf,

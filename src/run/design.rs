@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::{default_output_dir, Summary};
+use super::{default_output_dir, read_scene, target_line, Summary};
 use crate::design::{DesignReport, DesignSettings, IterationRecord, RelaxationKind};
 use crate::geometry::ReflectorMesh;
 use crate::network::Network;
@@ -14,6 +14,7 @@ use crate::report::{
 };
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
+use crate::surface::{RawAndBestFit, SurfaceBudget};
 use crate::verify::{CableModel, Verification};
 use crate::Error;
 
@@ -22,6 +23,8 @@ use crate::Error;
 pub struct DesignOutcome {
     /// The report (also in `design.json`).
     pub report: DesignReport,
+    /// What the scene's surface target says of the net, if it has one.
+    pub target: Option<String>,
     /// Files written.
     pub written: Vec<PathBuf>,
 }
@@ -68,6 +71,12 @@ impl DesignOutcome {
         if let Some(m) = &r.limit_margin {
             say!(s, "truss under the design's pull: {m}");
         }
+        for line in budget_lines(&r.surface) {
+            say!(s, "{line}");
+        }
+        if let Some(t) = &self.target {
+            say!(s, "{t}");
+        }
         let t = &r.timings;
         say!(
             s,
@@ -91,6 +100,35 @@ impl DesignOutcome {
         s.written(&self.written);
         s
     }
+}
+
+/// The surface error budget as printed: each term's axial RMS raw and about
+/// its best-fit paraboloid, the gain loss at the scene's frequency.
+fn budget_lines(b: &SurfaceBudget) -> Vec<String> {
+    let pair = |p: RawAndBestFit| {
+        format!(
+            "{} / {} mm",
+            readable(p.raw_mm, 4),
+            readable(p.best_fit_mm, 4)
+        )
+    };
+    let mut lines = vec![
+        "surface error budget (axial RMS, raw / about the best-fit paraboloid):".to_string(),
+        format!("  facets (design surface)      {}", pair(b.facets)),
+        format!("  design as built (free nodes) {}", pair(b.design_as_built)),
+        format!("  total (root-sum-square)      {}", pair(b.total)),
+        format!("  facets as built              {}", pair(b.facets_as_built)),
+    ];
+    if let (Some(ghz), Some(db)) = (b.frequency_ghz, b.gain_loss_db) {
+        lines.push(format!(
+            "gain loss at {} GHz: {} dB (Ruze, half-path RMS {} mm of the facets as built \
+             about their best fit)",
+            readable(ghz, 4),
+            readable(db, 4),
+            readable(b.half_path_best_fit_mm, 4)
+        ));
+    }
+    lines
 }
 
 /// One outer iteration of a design run, on one line (the CLI's progress on
@@ -134,7 +172,7 @@ pub fn design(
     observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
 ) -> Result<DesignOutcome, Error> {
     let clock = Instant::now();
-    let scene = Scene::read(scene_path)?;
+    let scene = read_scene(scene_path)?;
     let read_s = clock.elapsed().as_secs_f64();
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     check_scene(&scene, SceneCommand::Design, 1)?;
@@ -143,6 +181,7 @@ pub fn design(
     run.report.timings.read_s = read_s;
     let written = write_design(set, &scene, &run.mesh, &run.network, &mut run.report, clock)?;
     Ok(DesignOutcome {
+        target: target_line(&scene, run.report.surface.facets.raw_mm),
         report: run.report,
         written,
     })

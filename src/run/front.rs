@@ -3,13 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{default_output_dir, write_shard, Progress, Summary};
+use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
 use crate::design::scene_problem;
 use crate::report::{
     front_csv, front_plot, front_row, json_name, write_atomic, FrontRow, OutputSet, FRONT_COLUMNS,
 };
 use crate::resources::{check_memory, check_scene, SceneCommand};
-use crate::scene::Scene;
 use crate::shard::Shard;
 use crate::study;
 use crate::uniformity::{design_front_points, front_jobs, FrontPoint, SolverKind};
@@ -66,7 +65,7 @@ pub fn front(
     shard: Option<Shard>,
     progress: &dyn Progress,
 ) -> Result<FrontOutcome, Error> {
-    let scene = Scene::read(scene_path)?;
+    let scene = read_scene(scene_path)?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     // A shard writes one file under the folder's lock once computed; the
     // whole front takes the folder before computing.

@@ -46,7 +46,7 @@ pub use study::{study, StudyOptions, StudyOutcome, STUDY_STEM};
 pub use truss::{truss, TrussOutcome};
 pub use uniformity::{uniformity, UniformityOutcome, UniformityOutput};
 
-use crate::report::OutputSet;
+use crate::report::{readable, OutputSet};
 use crate::scene::Scene;
 use crate::shard::{self, Shard, ShardHeader};
 use crate::Error;
@@ -85,6 +85,50 @@ impl Summary {
 pub struct Silent;
 
 impl Progress for Silent {}
+
+/// Reads a scene file and completes it: a front net the file leaves to
+/// `[surface] rms_mm` becomes the coarsest net that meets it
+/// ([`crate::surface::resolve_front_rings`]).
+///
+/// # Errors
+/// The scene's errors; a target no net meets.
+pub fn read_scene(path: &Path) -> Result<Scene, crate::Error> {
+    Ok(crate::surface::resolve_front_rings(&Scene::read(path)?)?)
+}
+
+/// What a summary says of the scene's surface target, if it has one: how
+/// the rings were chosen for it, or whether the rings the file gives meet it
+/// (`facet_rms_mm`: the design surface's facet RMS with those rings).
+pub(crate) fn target_line(scene: &Scene, facet_rms_mm: f64) -> Option<String> {
+    let target = scene.surface.rms_mm?;
+    let rings = scene.front_net.rings;
+    Some(match &scene.front_net.chosen {
+        Some(c) => format!(
+            "front net: {rings} rings, the coarsest whose facet RMS (design surface) meets \
+             [surface] rms_mm = {} mm: {} mm{} ({} nets measured)",
+            readable(target, 4),
+            readable(c.facet_rms_mm, 4),
+            c.next_coarser.map_or(String::new(), |(r, f)| format!(
+                "; {r} rings give {} mm",
+                readable(f, 4)
+            )),
+            c.nets_built
+        ),
+        None if facet_rms_mm <= target => format!(
+            "[surface] rms_mm = {} mm: met by the front net's {rings} rings (facet RMS, \
+             design surface, {} mm)",
+            readable(target, 4),
+            readable(facet_rms_mm, 4)
+        ),
+        None => format!(
+            "[surface] rms_mm = {} mm: NOT met by the front net's {rings} rings (facet RMS, \
+             design surface, {} mm); give more rings, or leave front_net.rings out to have \
+             the coarsest net that meets it chosen",
+            readable(target, 4),
+            readable(facet_rms_mm, 4)
+        ),
+    })
+}
 
 /// Where a scene's results go by default: `results/<scene name>/`.
 pub fn default_output_dir(scene: &Scene) -> PathBuf {

@@ -5,13 +5,12 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::{default_output_dir, Summary};
+use super::{default_output_dir, read_scene, Summary};
 use crate::design::{default_solver, scene_problem};
 use crate::report::{
     cables_csv, json_name, readable, write_atomic, write_json, OutputSet, WithRun,
 };
 use crate::resources::{check_scene, SceneCommand};
-use crate::scene::Scene;
 use crate::uniformity::{Design, SolverKind};
 use crate::Error;
 
@@ -81,7 +80,7 @@ pub fn optimize(
     solver: Option<SolverKind>,
     output_dir: Option<&Path>,
 ) -> Result<OptimizeOutcome, Error> {
-    let scene = Scene::read(scene_path)?;
+    let scene = read_scene(scene_path)?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     check_scene(&scene, SceneCommand::Optimize, 1)?;
     let set = OutputSet::begin(&dir, &["design.json", "cables.csv"])?;

@@ -3,12 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{default_output_dir, Summary};
+use super::{default_output_dir, read_scene, Summary};
 use crate::design::DesignSettings;
 use crate::mechanics::LimitBound;
 use crate::report::{readable, sizing_csv, write_atomic, OutputSet};
 use crate::resources::{check_scene, SceneCommand};
-use crate::scene::Scene;
 use crate::sizing::{catalogue, size_truss, SectionTrial, Sections, Sizing};
 use crate::Error;
 
@@ -92,7 +91,7 @@ pub fn size(
     output_dir: Option<&Path>,
     observe: &mut dyn FnMut(&SectionTrial),
 ) -> Result<SizeOutcome, Error> {
-    let scene = Scene::read(scene_path)?;
+    let scene = read_scene(scene_path)?;
     let sections = match sections {
         Some(path) => Sections::Catalogue(catalogue::read(path, &scene.truss)?),
         None => Sections::Continuous {

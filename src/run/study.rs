@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{default_output_dir, write_shard, Progress, Summary};
+use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
 use crate::report::{study_csv, study_plot, study_row, write_atomic, OutputSet, STUDY_COLUMNS};
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::{Scene, TrussModel};
@@ -169,7 +169,7 @@ pub fn study(
     shard: Option<Shard>,
     progress: &dyn Progress,
 ) -> Result<StudyOutcome, Error> {
-    let scene = Scene::read(scene_path)?;
+    let scene = read_scene(scene_path)?;
     let settings = options.settings(&scene);
     settings.validate()?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);

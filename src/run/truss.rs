@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{default_output_dir, Summary};
+use super::{default_output_dir, read_scene, Summary};
 use crate::report::write_json;
-use crate::scene::{Scene, TrussModel};
+use crate::scene::TrussModel;
 use crate::truss::SceneTrussResponse;
 use crate::Error;
 
@@ -56,7 +56,7 @@ pub fn truss(
     loads_path: Option<&Path>,
     output_path: Option<&Path>,
 ) -> Result<TrussOutcome, Error> {
-    let scene = Scene::read(scene_path)?;
+    let scene = read_scene(scene_path)?;
     let model = model.unwrap_or(scene.effects.truss);
     let loads = match loads_path {
         Some(p) => Some((p.display().to_string(), crate::truss::read_loads(p)?)),

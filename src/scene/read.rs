@@ -90,6 +90,7 @@ impl Scene {
     /// A scene that is invalid with these rings, naming the key.
     pub fn with_rings(mut self, rings: usize) -> Result<Scene, SceneError> {
         self.front_net.rings = rings;
+        self.front_net.chosen = None;
         // A mean tension given as a membrane stress follows the net's spacing.
         if self.front_net.membrane_stress_n_per_m.is_some() {
             self.front_net.mean_tension_n = 0.0;

@@ -53,6 +53,21 @@ pub struct SurfaceSpec {
     pub frequency_ghz: Option<f64>,
 }
 
+/// The front net's rings as chosen for a facet RMS target: the coarsest net
+/// whose design surface meets it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChosenRings {
+    /// The target, mm.
+    pub target_rms_mm: f64,
+    /// Facet RMS of the chosen net's design surface, mm (at most the target).
+    pub facet_rms_mm: f64,
+    /// The net one ring coarser and its facet RMS, mm (above the target);
+    /// absent when the chosen net is the coarsest the generator makes.
+    pub next_coarser: Option<(usize, f64)>,
+    /// Nets generated and measured to choose.
+    pub nets_built: usize,
+}
+
 impl FrontNet {
     /// True when the file left the rings to the surface target: the scene is
     /// complete once they are chosen (`surface::resolve_front_rings`).
@@ -178,6 +193,10 @@ pub struct FrontNet {
     /// ([`FrontNet::rings_to_choose`]).
     #[serde(default)]
     pub rings: usize,
+    /// How the rings were chosen for `[surface] rms_mm`, when the file left
+    /// them to it (set with them, never read from or written to a file).
+    #[serde(skip)]
+    pub chosen: Option<ChosenRings>,
     /// Inward sag of the boundary at mid-bay, as a fraction of the bay chord.
     pub boundary_sag_ratio: f64,
     /// Target mean tension of the front net's interior cables, N: given, or

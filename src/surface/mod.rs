@@ -50,6 +50,7 @@
 //! (§12's figure), the sector nets' thin isosceles ones only ≈ 2.5×.
 
 mod best_fit;
+mod budget;
 mod error;
 mod gain;
 mod net_choice;
@@ -59,10 +60,12 @@ mod rms;
 mod samples;
 
 pub use best_fit::{best_fit_facets, best_fit_nodes, BestFit};
+pub use budget::{budget, design_surface_facets, FrontSurface, RawAndBestFit, SurfaceBudget};
 pub use error::SurfaceError;
 pub use gain::{ruze_gain_loss_db, ruze_gain_ratio, SPEED_OF_LIGHT_M_PER_S};
 pub use net_choice::{
-    choose_front_rings, choose_rings, max_front_rings, FacetNet, NetChoice, NetFigure,
+    choose_front_rings, choose_rings, max_front_rings, resolve_front_rings, FacetNet, NetChoice,
+    NetFigure,
 };
 pub use placed::{PlacedParaboloid, PointDeviation};
 pub use rms::{facet_rms, node_rms, Deviation, SurfaceRms};

@@ -5,7 +5,7 @@
 use super::rms::{check_paraboloid, facet_rms, Deviation};
 use super::SurfaceError;
 use crate::geometry::{build_mesh, Paraboloid, ReflectorMesh, MAX_NODES, MIN_CABLE_LENGTH_RATIO};
-use crate::scene::Scene;
+use crate::scene::{ChosenRings, Scene};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::ops::RangeInclusive;
@@ -231,9 +231,32 @@ pub fn choose_front_rings(
         deviation,
         2..=max_front_rings(scene),
         |rings| {
-            let mut trial = scene.clone();
-            trial.front_net.rings = rings;
+            // The scene with these rings, its tensions resolved for them.
+            let trial = scene.clone().with_rings(rings)?;
             Ok(FacetNet::front_of(&build_mesh(&trial)?))
         },
     )
+}
+
+/// `scene` complete: when its file left `front_net.rings` to `[surface]
+/// rms_mm`, with the coarsest net whose design surface meets that target
+/// (axial facet RMS, [`choose_front_rings`]) and how it was chosen
+/// ([`ChosenRings`]); otherwise `scene` as it is.
+///
+/// # Errors
+/// A target no net meets, or a scene invalid with the chosen rings.
+pub fn resolve_front_rings(scene: &Scene) -> Result<Scene, SurfaceError> {
+    let (true, Some(target_rms_mm)) = (scene.front_net.rings_to_choose(), scene.surface.rms_mm)
+    else {
+        return Ok(scene.clone());
+    };
+    let choice = choose_front_rings(scene, 1e-3 * target_rms_mm, Deviation::Axial)?;
+    let mut resolved = scene.clone().with_rings(choice.chosen.rings)?;
+    resolved.front_net.chosen = Some(ChosenRings {
+        target_rms_mm,
+        facet_rms_mm: 1e3 * choice.chosen.facet_rms_m,
+        next_coarser: choice.next_coarser.map(|n| (n.rings, 1e3 * n.facet_rms_m)),
+        nets_built: choice.nets_built,
+    });
+    Ok(resolved)
 }
