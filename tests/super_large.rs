@@ -75,10 +75,9 @@ fn the_super_large_scenes_are_dense_enough_for_their_surface() {
         let mesh = build_mesh(&scene).unwrap();
         let n = mesh.network.n_nodes() as f64;
         assert!(n >= nodes / 3.0 && n <= 3.0 * nodes, "{name}: {n} nodes");
-        let facet_mm = 1e3
-            * mesh
-                .paraboloid
-                .facet_rms_m(&mesh.network.nodes, &mesh.front_triangles);
+        let facet_mm = ringmesh::surface::design_surface_facets(&mesh)
+            .unwrap()
+            .raw_mm;
         assert!(
             (1.0..=2.5).contains(&facet_mm),
             "{name}: facet RMS {facet_mm} mm"

@@ -11,6 +11,7 @@ use crate::design::{LoopSettings, LoopSummary, SceneNets};
 use crate::scene::Scene;
 use crate::shard::Shard;
 use crate::status::Termination;
+use crate::surface::facet_rms;
 use crate::verify::{verify, AssemblyTruss};
 
 /// A design as built on the reference truss.
@@ -83,7 +84,15 @@ fn measure(
         AssemblyTruss::Flexible,
         None,
     )
-    .map(|v| {
+    // A point that cannot be judged is a row with its reason, not an error.
+    .map_err(|e| e.to_string())
+    .and_then(|v| {
+        let facets = facet_rms(
+            &nets.mesh.paraboloid,
+            &v.nodes_xyz_m[..nets.mesh.n_front_nodes],
+            &nets.mesh.front_triangles,
+        )
+        .map_err(|e| e.to_string())?;
         let built_ratio = outcome
             .problem
             .sets()
@@ -96,18 +105,14 @@ fn measure(
             .zip(&design.tensions_n)
             .map(|(&l, &t)| scene.cables.cut_length_m(l, t))
             .collect();
-        Judged {
+        Ok(Judged {
             built_ratio,
             rms_mm: v.rms_mm,
             max_deviation_mm: v.max_deviation_mm,
-            facet_rms_mm: 1e3
-                * nets
-                    .mesh
-                    .paraboloid
-                    .facet_rms_m(&v.nodes_xyz_m, &nets.mesh.front_triangles),
+            facet_rms_mm: 1e3 * facets.axial_m,
             tension_change_pct: v.max_tension_change_pct,
             cut_lengths_m,
-        }
+        })
     });
     let (judged, error) = match judged {
         Ok(j) => (Some(j), None),

@@ -28,7 +28,7 @@
 //! * `cut_length_error_mm` — largest difference of a cable's cut length from
 //!   the reference's, mm (same net only);
 //! * `facet_rms_mm` — RMS axial distance of the flat facets through the
-//!   assembled nodes from the paraboloid ([`crate::geometry::Paraboloid::facet_rms_m`]).
+//!   assembled nodes from the paraboloid, plan-area weighted ([`crate::surface::facet_rms`]).
 //!
 //! A net of other rings is another reflector: it cannot be compared cable by
 //! cable (no `cut_length_error_mm`), its `ratio_error` is mostly the change of

@@ -94,8 +94,9 @@ pub enum SurfaceError {
     },
     /// Even the finest net allowed misses the target.
     #[error(
-        "no net up to {rings} rings meets the facet RMS target {target_rms_m:e} m: \
-         {rings} rings give {facet_rms_m:e} m"
+        "`surface.rms_mm` = {} mm: no net up to {rings} rings (the finest this scene's \
+         generator makes) meets it: {rings} rings give a facet RMS of {} mm",
+        nanometres(*target_rms_m), nanometres(*facet_rms_m)
     )]
     TargetNotMet {
         /// The target, m.
@@ -121,6 +122,11 @@ pub enum SurfaceError {
         /// Its facet RMS, m.
         finer_rms_m: f64,
     },
+}
+
+/// A length in m as mm, to the nanometre (a message's precision).
+fn nanometres(m: f64) -> f64 {
+    (m * 1e9).round() / 1e6
 }
 
 impl SurfaceError {

@@ -1,6 +1,7 @@
 //! Why an assembly cannot be built or solved ([`VerifyError`]).
 
 use crate::mechanics::{MechanicsError, StaticTermination};
+use crate::surface::SurfaceError;
 use crate::truss::TrussError;
 
 /// An assembly that cannot be built or solved.
@@ -38,6 +39,10 @@ pub enum VerifyError {
     /// The assembled model is invalid (a cable of zero length, …), named.
     #[error("assembled model: {0}")]
     Mechanics(#[from] MechanicsError),
+    /// The surface as built cannot be measured (no free front node, a
+    /// non-finite position).
+    #[error("the surface as built: {0}")]
+    Surface(#[from] SurfaceError),
     /// The assembly found no equilibrium.
     #[error(
         "the assembled net and truss found no equilibrium: the solve {termination} (last \

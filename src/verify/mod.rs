@@ -34,6 +34,7 @@ use crate::mechanics::constraint_scale;
 use crate::mechanics::{Model, ModelBuilder, NodeId, StaticSettings, StaticSolver};
 use crate::network::Network;
 use crate::scene::Scene;
+use crate::surface::node_rms;
 use crate::truss::{ExactTruss, RingTruss, RingTrussBuilder, TrussEquilibrium, TrussOracle};
 use crate::uniformity::Design;
 
@@ -334,8 +335,9 @@ pub fn verify_on_frame(
         .iter()
         .map(|&i| mesh.paraboloid.axial_deviation(nodes_xyz_m[i]))
         .collect();
-    let rms =
-        (deviations.iter().map(|d| d * d).sum::<f64>() / deviations.len().max(1) as f64).sqrt();
+    // The node RMS of the free front nodes, as every report names it.
+    let free_front: Vec<[f64; 3]> = surface.iter().map(|&i| nodes_xyz_m[i]).collect();
+    let rms = node_rms(&mesh.paraboloid, &free_front)?.axial_m;
     let distance = |p: &[f64; 3], q: &[f64; 3]| norm3(std::array::from_fn(|c| p[c] - q[c]));
     let boundary = network
         .fixed
