@@ -11,7 +11,13 @@
 //! * Group `verify` — the converged design cut to length and assembled on the
 //!   flexible truss ([`ringmesh::verify::verify`]); ids the scene.
 //!
-//! Run with `cargo bench --bench design` (about a minute on two cores).
+//! * Group `net_choice` — what a surface target costs (issue 34): choosing
+//!   the coarsest net for `problems/target-40m.toml`'s 1.5 mm
+//!   ([`ringmesh::surface::resolve_front_rings`], geometry only) beside the
+//!   whole `design::run` of the scene it completes, in one run; the ratio is
+//!   printed.
+//!
+//! Run with `cargo bench --bench design` (about three minutes on two cores).
 
 use std::path::Path;
 use std::time::Duration;
@@ -21,8 +27,9 @@ use criterion::{
     criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion, SamplingMode,
 };
 use ringmesh::design::SceneNets;
-use ringmesh::design::{LoopOutcome, LoopSettings};
+use ringmesh::design::{DesignSettings, LoopOutcome, LoopSettings};
 use ringmesh::scene::{Scene, TrussModel};
+use ringmesh::surface::resolve_front_rings;
 use ringmesh::uniformity::{SolverKind, UniformitySolver};
 use ringmesh::verify::{verify, AssemblyTruss};
 
@@ -141,5 +148,46 @@ fn bench_design(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_design);
+fn bench_net_choice(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/target-40m.toml");
+    let scene = Scene::read(&path).expect("shipped scene");
+    let resolved = resolve_front_rings(&scene).expect("a net meets the target");
+    let mut group = c.benchmark_group("net_choice");
+    group
+        .sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_secs(1));
+    group.bench_function("choose/target-40m", |b| {
+        b.iter(|| resolve_front_rings(&scene).expect("a net meets the target"))
+    });
+    group.bench_function("design/target-40m", |b| {
+        b.iter(|| {
+            ringmesh::design::run(&resolved, &DesignSettings::default(), &mut |_, _| {})
+                .expect("the scene designs")
+        })
+    });
+    group.finish();
+    // The ratio, from one more timing of each in this run.
+    let time = |f: &dyn Fn()| {
+        let clock = std::time::Instant::now();
+        f();
+        clock.elapsed().as_secs_f64()
+    };
+    let choose_s = time(&|| drop(resolve_front_rings(&scene)));
+    let design_s = time(&|| {
+        drop(ringmesh::design::run(
+            &resolved,
+            &DesignSettings::default(),
+            &mut |_, _| {},
+        ))
+    });
+    eprintln!(
+        "net_choice: {} rings chosen in {choose_s:.3} s, the design {design_s:.2} s: {:.1} % \
+         of it",
+        resolved.front_net.rings,
+        100.0 * choose_s / design_s
+    );
+}
+
+criterion_group!(benches, bench_design, bench_net_choice);
 criterion_main!(benches);
