@@ -19,7 +19,7 @@ pub use aperture::aperture_plot;
 pub use convergence::convergence_plot;
 pub use frame_path::{path_plot, PathFigure};
 pub use front::front_plot;
-pub use surface_error::{surface_plot, NodePanel, SurfaceFigure};
+pub use surface_error::{surface_plot, PanelContent, PanelRms, SurfaceFigure, SurfacePanel};
 
 /// Floor for a logarithmic RMS axis, mm (an exact design has RMS ≈ 1e-12 mm).
 const RMS_FLOOR_MM: f64 = 1e-9;
