@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand};
 use ringmesh::design::RelaxationKind;
 use ringmesh::mechanics::ElementKind;
+use ringmesh::report::RmsAxis;
 use ringmesh::scene::TrussModel;
 use ringmesh::shard::Shard;
 use ringmesh::study::Knob;
@@ -235,6 +236,12 @@ pub enum Command {
         /// Knob values per solver.
         #[arg(long, default_value_t = 8)]
         points: usize,
+        /// The surface RMS the plot is drawn against: `design`, each point's
+        /// forward solve's; `total`, √(facets² + design²) with the facet RMS
+        /// of the net's design surface (a shard draws nothing; `merge` draws
+        /// against design).
+        #[arg(long, value_enum, default_value = "design")]
+        rms: RmsAxis,
         /// Run only shard I of N (from 0: point k runs when k mod N = I) and
         /// write front.shard-I-of-N.csv; join the shards with `ringmesh merge`.
         #[arg(long, value_name = "I/N")]
@@ -287,6 +294,12 @@ pub enum Command {
         /// Points run at once (1: one after the other, so each is timed alone).
         #[arg(long, default_value_t = 1, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
         jobs: usize,
+        /// The surface RMS the plot is drawn against: `design`, the RMS as
+        /// built; `total`, √(facets² + design²) with the facet RMS of each
+        /// net's design surface (a shard draws nothing; `merge` draws
+        /// against design).
+        #[arg(long, value_enum, default_value = "design")]
+        rms: RmsAxis,
         /// Run only shard I of N (from 0: point k runs when k mod N = I; every
         /// shard also runs the reference) and write
         /// accuracy-vs-time.shard-I-of-N.csv; join with `ringmesh merge`.

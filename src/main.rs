@@ -170,6 +170,7 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
             scene,
             solvers,
             points,
+            rms,
             shard,
             output,
         } => {
@@ -178,6 +179,7 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
                 scene,
                 solvers,
                 *points,
+                *rms,
                 output.as_deref(),
                 *shard,
                 &progress,
@@ -195,6 +197,7 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
             solvers,
             max_iterations,
             jobs,
+            rms,
             shard,
             output,
         } => {
@@ -207,6 +210,7 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
                 solvers: solvers.clone(),
                 max_iterations: *max_iterations,
                 jobs: *jobs,
+                rms: *rms,
             };
             let progress = bar();
             let result = run::study(scene, &options, output.as_deref(), *shard, &progress);

@@ -330,6 +330,39 @@ fn optimize_writes_design_and_cut_lengths() {
 }
 
 #[test]
+fn front_rms_total_draws_against_the_total_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "front");
+    let args = |rms: &str| {
+        common::ringmesh(&[
+            "front",
+            &common::problem_arg("small-hex.toml"),
+            "--solvers",
+            "lp",
+            "--rms",
+            rms,
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let run = args("total");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(stdout.contains("drawn against total RMS"), "{stdout}");
+    let csv = std::fs::read_to_string(out.join("front.csv")).unwrap();
+    assert_eq!(csv.lines().next(), Some("solver,knob,ratio,rms_mm,time_s"));
+    let svg = std::fs::read_to_string(out.join("front.svg")).unwrap();
+    assert!(svg.contains("total surface RMS"));
+    let bad = args("facets");
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("design, total"));
+}
+
+#[test]
 fn front_writes_csv_and_plots() {
     let dir = tempfile::tempdir().unwrap();
     let out = path(&dir, "front");
@@ -355,6 +388,7 @@ fn front_writes_csv_and_plots() {
     assert_eq!(&png[..4], b"\x89PNG");
     let svg = std::fs::read_to_string(out.join("front.svg")).unwrap();
     assert!(svg.contains("<svg") && svg.contains("bisection"));
+    assert!(!svg.contains("total surface RMS"));
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
         .filter(|e| {

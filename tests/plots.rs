@@ -1,7 +1,9 @@
 //! Every plot is drawn for every shipped scene (issue 20): `front`'s
 //! front, `study`'s accuracy against time, and `design`'s convergence and
-//! surface error. Pixels are not asserted; each picture must be written,
-//! non-empty, beside the table it draws. `design`'s plots of the other
+//! surface error; `front` and `study` drawn against the total RMS put each
+//! point where the surface budget's root-sum-square does (issue 34).
+//! Pixels are not asserted; each picture must be written, non-empty,
+//! beside the table it draws. `design`'s plots of the other
 //! scenes are drawn by `tests/scenes.rs` and `tests/super_large.rs`;
 //! `apertures`' by `tests/apertures.rs`.
 
@@ -10,9 +12,12 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use ringmesh::design::DesignSettings;
+use ringmesh::geometry::build_mesh;
+use ringmesh::report::{FrontRms, FrontRow, RmsAxis, StudyRms};
 use ringmesh::run::{self, Silent, StudyOptions};
 use ringmesh::scene::TrussModel;
 use ringmesh::study::Knob;
+use ringmesh::surface::design_surface_facets;
 use ringmesh::uniformity::SolverKind;
 
 /// Front rings of the super-large scenes here: their plots, not their size,
@@ -68,6 +73,7 @@ fn every_plot_is_drawn_for_every_shipped_scene() {
             &scene,
             &[SolverKind::Lp, SolverKind::LeastSquares],
             3,
+            RmsAxis::Design,
             Some(out.path()),
             None,
             &Silent,
@@ -105,4 +111,114 @@ fn every_plot_is_drawn_for_every_shipped_scene() {
             assert!(std::fs::metadata(&png).unwrap().len() > 1000, "{name}");
         }
     }
+}
+
+/// The facet RMS of the design surface of small-hex's net with `rings`
+/// rings, mm, from the scene file and [`ringmesh::surface`] alone.
+fn small_hex_facets_mm(rings: usize) -> f64 {
+    let mut scene = common::scene("small-hex");
+    scene.front_net.rings = rings;
+    design_surface_facets(&build_mesh(&scene).unwrap())
+        .unwrap()
+        .raw_mm
+}
+
+/// `√(f² + d²)` is the total to a few roundings, and at least each term.
+fn assert_total(total: f64, facets: f64, design: f64) {
+    let expected = (facets * facets + design * design).sqrt();
+    assert!(
+        (total - expected).abs() <= 4.0 * f64::EPSILON * expected,
+        "total {total}, √(facets² + design²) {expected}"
+    );
+    assert!(
+        total >= design && total >= facets,
+        "{total} {facets} {design}"
+    );
+}
+
+#[test]
+fn front_and_study_drawn_against_total_rms_add_the_net_s_facet_rms() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = common::problem("small-hex.toml");
+    let rings = common::scene("small-hex").front_net.rings;
+    let facets = small_hex_facets_mm(rings);
+    assert!(facets > 1.0, "small-hex's facets: {facets} mm");
+
+    let solvers = [SolverKind::Lp, SolverKind::LeastSquares];
+    let design = run::front(
+        &scene,
+        &solvers,
+        3,
+        RmsAxis::Design,
+        Some(dir.path()),
+        None,
+        &Silent,
+    )
+    .unwrap();
+    assert_eq!(design.rms, FrontRms::Design);
+    let total = run::front(
+        &scene,
+        &solvers,
+        3,
+        RmsAxis::Total,
+        Some(dir.path()),
+        None,
+        &Silent,
+    )
+    .unwrap();
+    assert_eq!(total.rms, FrontRms::Total { facets_mm: facets });
+    assert!(total
+        .summary()
+        .lines
+        .iter()
+        .any(|l| l.contains("total RMS")));
+    assert!(!design
+        .summary()
+        .lines
+        .iter()
+        .any(|l| l.contains("total RMS")));
+    let rows: Vec<FrontRow> = total.points.iter().filter_map(FrontRow::of).collect();
+    assert_eq!(rows.len(), 4);
+    for row in &rows {
+        assert_eq!(design.rms.of(row), row.rms_mm);
+        assert_total(total.rms.of(row), facets, row.rms_mm);
+    }
+    // Least squares trades accuracy for uniformity: its loosest point's
+    // total is above the facets by its own error, not lost under them.
+    let loosest = rows.iter().map(|r| total.rms.of(r)).fold(0.0, f64::max);
+    assert!(
+        loosest > facets * (1.0 + 1e-3),
+        "{loosest} against {facets}"
+    );
+
+    // The study: each point with the facets of its own net.
+    let options = StudyOptions {
+        knobs: vec![Knob::Rings],
+        truss_models: Some(vec![TrussModel::Rigid]),
+        rms: RmsAxis::Total,
+        ..StudyOptions::default()
+    };
+    let study = run::study(&scene, &options, Some(dir.path()), None, &Silent).unwrap();
+    let StudyRms::Total { facets_mm } = &study.rms else {
+        panic!("{:?}", study.rms);
+    };
+    let mut nets: Vec<usize> = study.rows.iter().map(|(_, r)| r.settings.rings).collect();
+    nets.sort_unstable();
+    nets.dedup();
+    assert!(nets.len() >= 3, "{nets:?}");
+    assert_eq!(facets_mm.iter().map(|f| f.0).collect::<Vec<_>>(), nets);
+    for &(r, f) in facets_mm {
+        assert_eq!(f, small_hex_facets_mm(r), "{r} rings");
+    }
+    // A finer net has smaller facets.
+    assert!(
+        facets_mm.windows(2).all(|w| w[1].1 < w[0].1),
+        "{facets_mm:?}"
+    );
+    for (_, row) in &study.rows {
+        assert!(row.error.is_none(), "{row:?}");
+        let f = small_hex_facets_mm(row.settings.rings);
+        assert_total(study.rms.of(row), f, row.rms_mm);
+    }
+    assert_drawn(dir.path(), run::STUDY_STEM, &scene);
 }

@@ -10,11 +10,12 @@ use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::report::{
     assembly_vtu, cables_csv, convergence_csv, convergence_plot, json_name, readable, surface_plot,
-    write_atomic, write_json, NodePanel, OutputSet, SurfaceFigure, WithRun,
+    write_atomic, write_json, OutputSet, PanelContent, PanelRms, SurfaceFigure, SurfacePanel,
+    WithRun,
 };
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
-use crate::surface::{RawAndBestFit, SurfaceBudget};
+use crate::surface::{PlacedParaboloid, RawAndBestFit, SurfaceBudget};
 use crate::verify::{CableModel, Verification};
 use crate::Error;
 
@@ -188,7 +189,9 @@ pub fn design(
 }
 
 /// The surface figure of a design run: the conventional design (when there
-/// is one) and ours as built, and ours's flat facets.
+/// is one) and ours as built, and ours's flat facets raw and about their
+/// best-fit paraboloid, each panel labelled with the RMS the report holds
+/// (the surface error budget's, [`crate::surface`]).
 fn surface_figure(
     scene: &Scene,
     mesh: &ReflectorMesh,
@@ -197,36 +200,72 @@ fn surface_figure(
 ) -> SurfaceFigure {
     let fixed = network.fixed_mask();
     let front = 0..mesh.n_front_nodes;
-    let deviation_mm = |p: [f64; 3]| 1e3 * mesh.paraboloid.axial_deviation(p);
-    let panel = |title: &str, v: &Verification| NodePanel {
-        title: title.to_string(),
-        nodes: front
-            .clone()
-            .filter(|&i| !fixed[i])
-            .map(|i| {
-                let p = v.nodes_xyz_m[i];
-                (p[0], p[1], deviation_mm(p))
+    let design = PlacedParaboloid::design(&mesh.paraboloid);
+    let budget = &report.surface;
+    let nodes = |v: &Verification| {
+        PanelContent::Nodes(
+            front
+                .clone()
+                .filter(|&i| !fixed[i])
+                .map(|i| {
+                    let p = v.nodes_xyz_m[i];
+                    (p[0], p[1], 1e3 * design.deviation(p).axial_m)
+                })
+                .collect(),
+        )
+    };
+    let ours = &report.verification;
+    let plan = |i: usize| (ours.nodes_xyz_m[i][0], ours.nodes_xyz_m[i][1]);
+    // Each facet cut into equal parts, each coloured by the axial deviation
+    // at its centroid about `about`: a facet's bulge shows, and about the
+    // best fit, its straddling of the surface.
+    let per_side = facet_parts_per_side(mesh.front_triangles.len());
+    let facets = |about: &PlacedParaboloid| PanelContent::Facets {
+        parts_per_side: per_side,
+        parts: mesh
+            .front_triangles
+            .iter()
+            .flat_map(|t| facet_parts(t.map(|i| ours.nodes_xyz_m[i]), per_side))
+            .map(|part| {
+                let centroid: [f64; 3] =
+                    std::array::from_fn(|c| part.iter().map(|p| p[c]).sum::<f64>() / 3.0);
+                (
+                    part.map(|p| (p[0], p[1])),
+                    1e3 * about.deviation(centroid).axial_m,
+                )
             })
             .collect(),
     };
-    let ours = &report.verification;
-    let mut panels: Vec<NodePanel> = report
+    let mut panels: Vec<SurfacePanel> = report
         .conventional
         .iter()
-        .map(|c| panel("conventional (rigid-truss) design as built", c))
-        .collect();
-    panels.push(panel("this design as built", ours));
-    let plan = |i: usize| (ours.nodes_xyz_m[i][0], ours.nodes_xyz_m[i][1]);
-    let facets = mesh
-        .front_triangles
-        .iter()
-        .map(|t| {
-            let centroid: [f64; 3] = std::array::from_fn(|c| {
-                t.iter().map(|&i| ours.nodes_xyz_m[i][c]).sum::<f64>() / 3.0
-            });
-            (t.map(plan), deviation_mm(centroid))
+        .map(|c| SurfacePanel {
+            title: "conventional (rigid-truss) design as built".to_string(),
+            rms: PanelRms::Node,
+            rms_mm: c.rms_mm,
+            content: nodes(c),
         })
         .collect();
+    panels.extend([
+        SurfacePanel {
+            title: "design as built".to_string(),
+            rms: PanelRms::Node,
+            rms_mm: budget.design_as_built.raw_mm,
+            content: nodes(ours),
+        },
+        SurfacePanel {
+            title: "facets as built".to_string(),
+            rms: PanelRms::Facet,
+            rms_mm: budget.facets_as_built.raw_mm,
+            content: facets(&design),
+        },
+        SurfacePanel {
+            title: "facets as built, about their best-fit paraboloid".to_string(),
+            rms: PanelRms::BestFitFacet,
+            rms_mm: budget.facets_as_built.best_fit_mm,
+            content: facets(&budget.best_fit),
+        },
+    ]);
     let cables = network
         .edges
         .iter()
@@ -235,14 +274,47 @@ fn surface_figure(
         .collect();
     SurfaceFigure {
         title: format!(
-            "{}: surface as built on the flexible truss, axial deviation from the paraboloid (mm)",
+            "{}: surface as built on the flexible truss, axial deviation (mm)",
             scene.name
         ),
         panels,
-        facets,
         cables,
         outline: mesh.truss.top_m.iter().map(|p| (p[0], p[1])).collect(),
     }
+}
+
+/// Parts of a facet drawn at most, over all the facets of a panel.
+const MAX_FACET_PARTS: usize = 20_000;
+
+/// The parts per side each facet of a net of `facets` is cut into for its
+/// colours: as many as [`MAX_FACET_PARTS`] allows, 1 to 4.
+fn facet_parts_per_side(facets: usize) -> usize {
+    ((MAX_FACET_PARTS as f64 / facets.max(1) as f64).sqrt() as usize).clamp(1, 4)
+}
+
+/// The flat triangle `corners` cut into `n²` equal triangles (`n` parts
+/// a side), corners in space, m.
+fn facet_parts(corners: [[f64; 3]; 3], n: usize) -> Vec<[[f64; 3]; 3]> {
+    // The point (i, j) of the grid: corner 0 moved i/n along side 0→1 and
+    // j/n along side 0→2.
+    let at = |i: usize, j: usize| -> [f64; 3] {
+        let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
+        std::array::from_fn(|c| {
+            corners[0][c]
+                + a * (corners[1][c] - corners[0][c])
+                + b * (corners[2][c] - corners[0][c])
+        })
+    };
+    let mut parts = Vec::with_capacity(n * n);
+    for i in 0..n {
+        for j in 0..n - i {
+            parts.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+            if i + j + 2 <= n {
+                parts.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+    }
+    parts
 }
 
 /// The files of `ringmesh design`.
@@ -317,4 +389,100 @@ fn write_design(
     report.timings.total_s = clock.elapsed().as_secs_f64();
     write_json(&path("design.json"), &WithRun { run: &run, report })?;
     Ok(set.commit()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn facet_parts_tile_the_facet_into_equal_triangles() {
+        let corners = [[0.0, 0.0, 1.0], [3.0, 0.0, 2.0], [0.0, 3.0, 4.0]];
+        let plan_area = |t: &[[f64; 3]; 3]| {
+            0.5 * ((t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
+                - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]))
+                .abs()
+        };
+        for n in 1..=4 {
+            let parts = facet_parts(corners, n);
+            assert_eq!(parts.len(), n * n);
+            for part in &parts {
+                let area = plan_area(part);
+                assert!((area - 4.5 / (n * n) as f64).abs() < 1e-14, "n {n}: {area}");
+                // Every corner of a part lies on the facet's plane z = 1 + x/3 + y.
+                for p in part {
+                    assert!((p[2] - (1.0 + p[0] / 3.0 + p[1])).abs() < 1e-14, "{p:?}");
+                }
+            }
+        }
+        assert_eq!(facet_parts_per_side(54), 4);
+        assert_eq!(facet_parts_per_side(30_000), 1);
+    }
+
+    #[test]
+    fn surface_figure_labels_each_panel_with_the_budget_s_numbers() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml");
+        let scene = read_scene(&path).unwrap();
+        let run = crate::design::run(&scene, &DesignSettings::default(), &mut |_, _| {}).unwrap();
+        let figure = surface_figure(&scene, &run.mesh, &run.network, &run.report);
+        let budget = &run.report.surface;
+        let printed = budget_lines(budget).join("\n");
+        let conventional = run.report.conventional.as_ref().unwrap();
+        let expected = [
+            (
+                "conventional (rigid-truss) design as built",
+                PanelRms::Node,
+                conventional.rms_mm,
+            ),
+            (
+                "design as built",
+                PanelRms::Node,
+                budget.design_as_built.raw_mm,
+            ),
+            (
+                "facets as built",
+                PanelRms::Facet,
+                budget.facets_as_built.raw_mm,
+            ),
+            (
+                "facets as built, about their best-fit paraboloid",
+                PanelRms::BestFitFacet,
+                budget.facets_as_built.best_fit_mm,
+            ),
+        ];
+        assert_eq!(figure.panels.len(), expected.len());
+        for (panel, (title, rms, value)) in figure.panels.iter().zip(expected) {
+            assert_eq!(
+                (panel.title.as_str(), panel.rms, panel.rms_mm),
+                (title, rms, value)
+            );
+            // The label's number is the one `design` prints.
+            let number = readable(value, 4);
+            assert!(panel
+                .label()
+                .contains(&format!("{} {number} mm (", rms.name())));
+            if rms != PanelRms::Node || title == "design as built" {
+                assert!(printed.contains(&number), "{number} not in\n{printed}");
+            }
+        }
+        let labels: Vec<String> = figure.panels.iter().map(SurfacePanel::label).collect();
+        assert_eq!(
+            labels[2],
+            format!(
+                "facets as built: facet RMS {} mm (axial, plan-area weighted)",
+                readable(budget.facets_as_built.raw_mm, 4)
+            )
+        );
+        assert!(labels.iter().all(|l| !l.contains("centroid")), "{labels:?}");
+        // The facets as built bulge above the design paraboloid everywhere
+        // (their nodes are on it); about the best fit they straddle it.
+        let parts = |panel: &SurfacePanel| match &panel.content {
+            PanelContent::Facets { parts, .. } => parts.iter().map(|p| p.1).collect::<Vec<_>>(),
+            PanelContent::Nodes(_) => panic!("{}: not facets", panel.title),
+        };
+        let (raw, best_fit) = (parts(&figure.panels[2]), parts(&figure.panels[3]));
+        assert_eq!(raw.len(), 16 * run.mesh.front_triangles.len());
+        assert!(raw.iter().all(|&d| d > 0.0));
+        assert!(best_fit.iter().any(|&d| d > 0.0) && best_fit.iter().any(|&d| d < 0.0));
+    }
 }

@@ -6,11 +6,13 @@ use std::path::{Path, PathBuf};
 use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
 use crate::design::scene_problem;
 use crate::report::{
-    front_csv, front_plot, front_row, json_name, write_atomic, FrontRow, OutputSet, FRONT_COLUMNS,
+    front_csv, front_plot, front_row, json_name, readable, write_atomic, FrontRms, FrontRow,
+    OutputSet, RmsAxis, FRONT_COLUMNS,
 };
 use crate::resources::{check_memory, check_scene, SceneCommand};
 use crate::shard::Shard;
 use crate::study;
+use crate::surface::design_surface_facets;
 use crate::uniformity::{design_front_points, front_jobs, FrontPoint, SolverKind};
 use crate::Error;
 
@@ -19,13 +21,16 @@ use crate::Error;
 pub struct FrontOutcome {
     /// The points run, in sweep order.
     pub points: Vec<FrontPoint>,
+    /// The surface RMS the points are drawn at.
+    pub rms: FrontRms,
     /// Files written.
     pub written: Vec<PathBuf>,
 }
 
 impl FrontOutcome {
     /// What `ringmesh front` prints: one line per point (its ratio, RMS and
-    /// time, or why it failed), the files written.
+    /// time, or why it failed), the facet RMS a total RMS is drawn with, the
+    /// files written.
     pub fn summary(&self) -> Summary {
         let mut s = Summary::default();
         for p in &self.points {
@@ -48,19 +53,29 @@ impl FrontOutcome {
                 ),
             }
         }
+        if let FrontRms::Total { facets_mm } = self.rms {
+            say!(
+                s,
+                "drawn against total RMS √(facets² + RMS²), facets: facet RMS of the net's \
+                 design surface {} mm",
+                readable(facets_mm, 4)
+            );
+        }
         s.written(&self.written);
         s
     }
 }
 
 /// `ringmesh front`: the design front of a scene (each solver's knob swept in
-/// parallel), written as `front.csv`, `front.png` and `front.svg`; with a
-/// `shard`, only that shard's points, written as `front.shard-I-of-N.csv`
-/// (see [`crate::shard`]; `ringmesh merge` makes the table and the plot).
+/// parallel), written as `front.csv`, `front.png` and `front.svg`, the plot
+/// drawn against the surface RMS `rms` chooses; with a `shard`, only that
+/// shard's points, written as `front.shard-I-of-N.csv` (see
+/// [`crate::shard`]; `ringmesh merge` makes the table and the plot).
 pub fn front(
     scene_path: &Path,
     solvers: &[SolverKind],
     points: usize,
+    rms: RmsAxis,
     output_dir: Option<&Path>,
     shard: Option<Shard>,
     progress: &dyn Progress,
@@ -85,7 +100,15 @@ pub fn front(
         Some(_) => None,
         None => Some(OutputSet::begin(&dir, &FILES)?),
     };
-    let (_, problem) = scene_problem(&scene)?;
+    let (mesh, problem) = scene_problem(&scene)?;
+    let rms = match rms {
+        RmsAxis::Design => FrontRms::Design,
+        RmsAxis::Total => FrontRms::Total {
+            facets_mm: design_surface_facets(&mesh)?.raw_mm,
+        },
+    };
+    // The front's solves need the problem alone.
+    drop(mesh);
     let jobs = front_jobs(&problem, solvers, points);
     let indices = shard.unwrap_or(Shard::WHOLE).points(jobs.len());
     let mine: Vec<(SolverKind, f64)> = indices.iter().map(|&k| jobs[k]).collect();
@@ -125,6 +148,7 @@ pub fn front(
         )?;
         return Ok(FrontOutcome {
             points: front,
+            rms,
             written: vec![path],
         });
     };
@@ -134,9 +158,17 @@ pub fn front(
         .filter(|p| p.outcome.is_err())
         .map(|p| (study::value_name(&p.solver), p.knob))
         .collect();
-    let paths = write_front(set, &scene.name, &rows, Some(&failed), &front_csv(&rows))?;
+    let paths = write_front(
+        set,
+        &scene.name,
+        &rows,
+        Some(&failed),
+        &rms,
+        &front_csv(&rows),
+    )?;
     Ok(FrontOutcome {
         points: front,
+        rms,
         written: paths,
     })
 }
@@ -148,20 +180,22 @@ const BYTES_PER_POINT: u64 = 512;
 /// The files of a whole front.
 pub(crate) const FILES: [&str; 3] = ["front.csv", "front.png", "front.svg"];
 
-/// `front.csv` (the table `csv`), `front.png`, `front.svg` (drawn from `rows`,
-/// the `failed` points — solver, knob — listed when known), written into
-/// `set` (begun with [`FILES`]) and swapped in.
+/// `front.csv` (the table `csv`), `front.png`, `front.svg` (drawn from `rows`
+/// against `rms`, the `failed` points — solver, knob — listed when known),
+/// written into `set` (begun with [`FILES`]) and swapped in.
 pub(crate) fn write_front(
     set: OutputSet,
     scene: &str,
     rows: &[FrontRow],
     failed: Option<&[(String, f64)]>,
+    rms: &FrontRms,
     csv: &str,
 ) -> Result<Vec<PathBuf>, Error> {
     let title = format!("{scene}: tension uniformity against surface accuracy");
     front_plot(
         rows,
         failed,
+        rms,
         &title,
         &set.path("front.png"),
         &set.path("front.svg"),

@@ -7,7 +7,7 @@ use super::front::{self, write_front};
 use super::study::{self, write_study};
 use super::Summary;
 use crate::report::OutputSet;
-use crate::report::{parse_front_row, parse_study_row, FrontRow};
+use crate::report::{parse_front_row, parse_study_row, FrontRms, FrontRow, StudyRms};
 use crate::shard::{self, ShardError};
 use crate::study::StudyRow;
 use crate::Error;
@@ -106,11 +106,18 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<MergeOutcom
         let written = match table {
             Table::Front(rows) => {
                 let set = OutputSet::begin(&dir, &front::FILES)?;
-                write_front(set, &m.header.scene, &rows, None, &m.csv())?
+                write_front(
+                    set,
+                    &m.header.scene,
+                    &rows,
+                    None,
+                    &FrontRms::Design,
+                    &m.csv(),
+                )?
             }
             Table::Study(rows) => {
                 let set = OutputSet::begin(&dir, &study::FILES)?;
-                write_study(set, &m.header.scene, &rows, &m.csv())?
+                write_study(set, &m.header.scene, &rows, &StudyRms::Design, &m.csv())?
             }
         };
         outcomes.push(MergedTable {

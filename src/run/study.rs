@@ -4,11 +4,16 @@
 use std::path::{Path, PathBuf};
 
 use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
-use crate::report::{study_csv, study_plot, study_row, write_atomic, OutputSet, STUDY_COLUMNS};
+use crate::geometry::build_mesh;
+use crate::report::{
+    readable, study_csv, study_plot, study_row, write_atomic, OutputSet, RmsAxis, StudyRms,
+    STUDY_COLUMNS,
+};
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::{Scene, TrussModel};
 use crate::shard::Shard;
 use crate::study::{self, Knob, StudyRow, StudySettings};
+use crate::surface::design_surface_facets;
 use crate::uniformity::SolverKind;
 use crate::Error;
 
@@ -32,6 +37,8 @@ pub struct StudyOptions {
     pub max_iterations: Option<usize>,
     /// Points run at once (1: one after the other, each timed alone).
     pub jobs: usize,
+    /// The surface RMS the plot is drawn against.
+    pub rms: RmsAxis,
 }
 
 impl Default for StudyOptions {
@@ -45,6 +52,7 @@ impl Default for StudyOptions {
             solvers: None,
             max_iterations: None,
             jobs: 1,
+            rms: RmsAxis::Design,
         }
     }
 }
@@ -84,6 +92,8 @@ pub struct StudyOutcome {
     pub rows: Vec<(usize, StudyRow)>,
     /// Points of the whole sweep.
     pub points: usize,
+    /// The surface RMS the rows are drawn at.
+    pub rms: StudyRms,
     /// Files written.
     pub written: Vec<PathBuf>,
 }
@@ -91,7 +101,7 @@ pub struct StudyOutcome {
 impl StudyOutcome {
     /// What `ringmesh study` prints: a table of the points run (knob,
     /// value, design time, accuracy as built, or why a point failed), the
-    /// files written.
+    /// facet RMS a total RMS is drawn with, the files written.
     pub fn summary(&self) -> Summary {
         let mut s = Summary::default();
         say!(
@@ -143,6 +153,18 @@ impl StudyOutcome {
                 ),
             }
         }
+        if let StudyRms::Total { facets_mm } = &self.rms {
+            let nets: Vec<String> = facets_mm
+                .iter()
+                .map(|(rings, f)| format!("{rings} rings {} mm", readable(*f, 4)))
+                .collect();
+            say!(
+                s,
+                "drawn against total RMS √(facets² + RMS²), facets: facet RMS of each net's \
+                 design surface: {}",
+                nets.join(", ")
+            );
+        }
         s.written(&self.written);
         s
     }
@@ -159,7 +181,8 @@ macro_rules! stem {
 pub const STUDY_STEM: &str = stem!();
 
 /// `ringmesh study`: what accuracy costs in time ([`crate::study`]). Writes
-/// `accuracy-vs-time.csv`, `.png` and `.svg`; with a `shard`, only that
+/// `accuracy-vs-time.csv`, `.png` and `.svg` (drawn against the surface RMS
+/// `options.rms` chooses); with a `shard`, only that
 /// shard's points (and the reference, run to judge them), written as
 /// `accuracy-vs-time.shard-I-of-N.csv`.
 pub fn study(
@@ -192,6 +215,12 @@ pub fn study(
         let point = format!("{} {}", r.knob.name(), r.value);
         progress.step(&format!("{}: {outcome}", point.trim_end()));
     })?;
+    let rms = match options.rms {
+        RmsAxis::Design => StudyRms::Design,
+        RmsAxis::Total => StudyRms::Total {
+            facets_mm: design_surface_facets_by_rings(&scene, &rows)?,
+        },
+    };
     let written = match set {
         None => {
             let shard = shard.unwrap_or(Shard::WHOLE);
@@ -212,15 +241,43 @@ pub fn study(
         }
         Some(set) => {
             let table: Vec<StudyRow> = rows.iter().map(|(_, r)| r.clone()).collect();
-            write_study(set, &scene.name, &table, &study_csv(&table))?
+            write_study(set, &scene.name, &table, &rms, &study_csv(&table))?
         }
     };
     Ok(StudyOutcome {
         scene: scene.name,
         rows,
         points: total,
+        rms,
         written,
     })
+}
+
+/// The facet RMS of the design surface of each net the successful `rows`
+/// designed, `(rings, mm)` in ascending rings: the scene's front net with
+/// their rings, as the study builds it.
+///
+/// # Errors
+/// A net that cannot be built or measured.
+fn design_surface_facets_by_rings(
+    scene: &Scene,
+    rows: &[(usize, StudyRow)],
+) -> Result<Vec<(usize, f64)>, Error> {
+    let mut rings: Vec<usize> = rows
+        .iter()
+        .filter(|(_, r)| r.error.is_none())
+        .map(|(_, r)| r.settings.rings)
+        .collect();
+    rings.sort_unstable();
+    rings.dedup();
+    rings
+        .into_iter()
+        .map(|r| {
+            let mut net = scene.clone();
+            net.front_net.rings = r;
+            Ok((r, design_surface_facets(&build_mesh(&net)?)?.raw_mm))
+        })
+        .collect()
 }
 
 /// The files of a whole study (stem [`STUDY_STEM`]).
@@ -231,17 +288,19 @@ pub(crate) const FILES: [&str; 3] = [
 ];
 
 /// `accuracy-vs-time.csv` (the table `csv`), `.png`, `.svg` (drawn from
-/// `rows`), written into `set` (begun with [`FILES`]) and swapped in.
+/// `rows` against `rms`), written into `set` (begun with [`FILES`]) and
+/// swapped in.
 pub(crate) fn write_study(
     set: OutputSet,
     scene: &str,
     rows: &[StudyRow],
+    rms: &StudyRms,
     csv: &str,
 ) -> Result<Vec<PathBuf>, Error> {
     let [csv_path, png, svg] = FILES.map(|name| set.path(name));
     let title =
         format!("{scene}: what accuracy costs in time (designs as built on the reference truss)");
-    study_plot(rows, &title, &png, &svg)?;
+    study_plot(rows, rms, &title, &png, &svg)?;
     write_atomic(&csv_path, csv.as_bytes())?;
     set.seal()?;
     Ok(set.commit()?)

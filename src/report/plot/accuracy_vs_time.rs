@@ -1,6 +1,6 @@
-//! The accuracy study's figure: surface RMS and ratio error as built
-//! against the design's wall time, one colour per knob, the Pareto front
-//! ringed.
+//! The accuracy study's figure: surface RMS (the design's as built, or the
+//! total with each net's facet RMS) and ratio error as built against the
+//! design's wall time, one colour per knob, the Pareto front ringed.
 
 use std::path::Path;
 
@@ -8,9 +8,48 @@ use plotters::prelude::*;
 
 use super::canvas::{png_and_svg, titled_with_legend};
 use super::labels::{label_font, place_labels};
-use super::RMS_FLOOR_MM;
+use super::{total_rms_mm, RMS_FLOOR_MM};
 use crate::report::{DrawError, ReportError};
 use crate::study::{pareto_optimal, Knob, StudyRow};
+
+/// The surface RMS the study's points are drawn at (`--rms`,
+/// [`super::RmsAxis`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum StudyRms {
+    /// Each point's RMS as built.
+    Design,
+    /// The total `√(facets² + RMS as built²)` ([`total_rms_mm`]), with the
+    /// facet RMS of the design surface of each point's net.
+    Total {
+        /// `(front-net rings, facet RMS of that net's design surface, mm)`,
+        /// for every net of the rows drawn (a row whose net is missing is
+        /// not drawn).
+        facets_mm: Vec<(usize, f64)>,
+    },
+}
+
+impl StudyRms {
+    /// The RMS `row` is drawn at, mm.
+    pub fn of(&self, row: &StudyRow) -> f64 {
+        match self {
+            StudyRms::Design => row.rms_mm,
+            StudyRms::Total { facets_mm } => facets_mm
+                .iter()
+                .find(|(rings, _)| *rings == row.settings.rings)
+                .map_or(f64::NAN, |&(_, f)| total_rms_mm(f, row.rms_mm)),
+        }
+    }
+
+    /// The axis's caption.
+    fn caption(&self) -> &'static str {
+        match self {
+            StudyRms::Design => "surface RMS as built on the reference truss (mm)",
+            StudyRms::Total { .. } => {
+                "total RMS √(facets² + as built²) (mm); facets: each net's design surface"
+            }
+        }
+    }
+}
 
 /// Floor of a logarithmic ratio-error axis (the reference itself has 0).
 const RATIO_ERROR_FLOOR: f64 = 1e-12;
@@ -19,7 +58,7 @@ const RATIO_ERROR_FLOOR: f64 = 1e-12;
 struct StudyPanel<'a> {
     y_desc: &'a str,
     floor: f64,
-    error: fn(&StudyRow) -> f64,
+    error: &'a dyn Fn(&StudyRow) -> f64,
 }
 
 fn knob_colour(knob: Knob) -> RGBAColor {
@@ -167,6 +206,7 @@ where
 fn draw_study<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     rows: &[StudyRow],
+    rms: &StudyRms,
     title: &str,
 ) -> Result<(), DrawError>
 where
@@ -174,24 +214,25 @@ where
 {
     let (charts, legend) = titled_with_legend(&root, title, 35)?;
     let panels = charts.split_evenly((1, 2));
-    let rms = StudyPanel {
-        y_desc: "surface RMS as built on the reference truss (mm)",
+    let surface = StudyPanel {
+        y_desc: rms.caption(),
         floor: RMS_FLOOR_MM,
-        error: |r| r.rms_mm,
+        error: &|r| rms.of(r),
     };
     let ratio = StudyPanel {
         y_desc: "ratio error |Tmax/Tmin − reference| / reference, as built",
         floor: RATIO_ERROR_FLOOR,
-        error: |r| r.ratio_error,
+        error: &|r| r.ratio_error,
     };
-    draw_study_panel(&panels[0], rows, &rms)?;
+    draw_study_panel(&panels[0], rows, &surface)?;
     draw_study_panel(&panels[1], rows, &ratio)?;
     draw_study_legend(&legend, rows)?;
     Ok(root.present()?)
 }
 
 /// Draws the accuracy study as PNG and SVG, each written atomically: two
-/// log–log panels, surface RMS and ratio error (as built) against the
+/// log–log panels, surface RMS (`rms`: the design's, or the total with each
+/// net's facet RMS) and ratio error (as built) against the
 /// design's wall time, one colour per knob, each point labelled with its
 /// value (the scene's own settings, which every sweep contains, once as
 /// `baseline`); the Pareto-optimal points among the designs of the
@@ -199,9 +240,10 @@ where
 /// (1e-9 mm, 1e-12) are drawn at the floor.
 pub fn study_plot(
     rows: &[StudyRow],
+    rms: &StudyRms,
     title: &str,
     png: &Path,
     svg: &Path,
 ) -> Result<(), ReportError> {
-    png_and_svg!(draw_study, (1600, 720), png, svg, rows, title)
+    png_and_svg!(draw_study, (1600, 720), png, svg, rows, rms, title)
 }

@@ -1,36 +1,137 @@
-//! The surface error of a design: plan views of the designs as built and of
-//! our flat facets, coloured by their axial deviation from the paraboloid on
-//! one signed logarithmic scale in mm.
+//! The surface error of a design: plan views of the designs as built (their
+//! free nodes) and of the flat facets of ours, raw and about their best-fit
+//! paraboloid, coloured by axial deviation on one signed logarithmic scale
+//! in mm. Each panel is labelled with one RMS of [`crate::surface`], by its
+//! one name, with the value the design's report holds (the plot computes no
+//! RMS).
 
 use std::path::Path;
 
 use plotters::prelude::*;
 
 use super::canvas::{png_bytes, register_font};
-use crate::report::{write_atomic, DrawError, ReportError};
+use crate::report::{readable, write_atomic, DrawError, ReportError};
 
-/// One panel of the surface figure: the assembled front net's free nodes,
-/// `(x, y, deviation mm)`.
-#[derive(Debug, Clone)]
-pub struct NodePanel {
-    /// The panel's title.
-    pub title: String,
-    /// The nodes: plan position, m, and axial deviation from the paraboloid, mm.
-    pub nodes: Vec<(f64, f64, f64)>,
+/// The RMS a panel is labelled with: one quantity of [`crate::surface`], by
+/// its one name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PanelRms {
+    /// Node RMS ([`crate::surface::node_rms`]): the axial deviation of the
+    /// front net's free nodes from the design paraboloid, each node counting
+    /// once.
+    Node,
+    /// Facet RMS ([`crate::surface::facet_rms`]): the axial deviation of the
+    /// flat facets from the design paraboloid, integrated over them and
+    /// weighted by plan area.
+    Facet,
+    /// Best-fit facet RMS ([`crate::surface::best_fit_facets`]): the facet
+    /// RMS about the paraboloid fitted to the facets.
+    BestFitFacet,
 }
 
-/// The surface figure of a design (issue 20): the designs as built side by
-/// side and the facet error of ours, on one signed colour scale in mm.
+impl PanelRms {
+    /// The quantity's one name.
+    pub fn name(self) -> &'static str {
+        match self {
+            PanelRms::Node => "node RMS",
+            PanelRms::Facet => "facet RMS",
+            PanelRms::BestFitFacet => "best-fit facet RMS",
+        }
+    }
+
+    /// Which deviation, over what.
+    fn qualifier(self) -> &'static str {
+        match self {
+            PanelRms::Node => "axial, free nodes",
+            PanelRms::Facet | PanelRms::BestFitFacet => "axial, plan-area weighted",
+        }
+    }
+}
+
+/// What a panel colours: points of the front net in plan, m, each with an
+/// axial deviation, mm, about the panel's paraboloid (the design one, or the
+/// best fit for [`PanelRms::BestFitFacet`]).
+#[derive(Debug, Clone)]
+pub enum PanelContent {
+    /// Free nodes `(x, y, deviation)`.
+    Nodes(Vec<(f64, f64, f64)>),
+    /// Flat facets, each cut into `parts_per_side²` equal triangles (1: the
+    /// facets themselves): each part's plan corners and the deviation at
+    /// its centroid.
+    Facets {
+        /// Parts a side of a facet.
+        parts_per_side: usize,
+        /// The parts.
+        parts: Vec<([(f64, f64); 3], f64)>,
+    },
+}
+
+impl PanelContent {
+    /// The deviations coloured, mm.
+    fn deviations(&self) -> Box<dyn Iterator<Item = f64> + '_> {
+        match self {
+            PanelContent::Nodes(nodes) => Box::new(nodes.iter().map(|n| n.2)),
+            PanelContent::Facets { parts, .. } => Box::new(parts.iter().map(|f| f.1)),
+        }
+    }
+}
+
+/// One panel of the surface figure.
+#[derive(Debug, Clone)]
+pub struct SurfacePanel {
+    /// What it shows, e.g. `facets as built`.
+    pub title: String,
+    /// The RMS it is labelled with …
+    pub rms: PanelRms,
+    /// … and its value, mm, as the design's report gives it.
+    pub rms_mm: f64,
+    /// What it colours.
+    pub content: PanelContent,
+}
+
+impl SurfacePanel {
+    /// The quantity and its value, e.g. `facet RMS 15.19 mm (axial,
+    /// plan-area weighted)`: the number as `design` prints it.
+    pub fn rms_line(&self) -> String {
+        format!(
+            "{} {} mm ({})",
+            self.rms.name(),
+            readable(self.rms_mm, 4),
+            self.rms.qualifier()
+        )
+    }
+
+    /// What a colour of the panel is (a colour, not a reported RMS), about
+    /// the panel's paraboloid.
+    pub fn colour_note(&self) -> String {
+        match &self.content {
+            PanelContent::Nodes(_) => "colour: axial deviation of each free node".to_string(),
+            PanelContent::Facets {
+                parts_per_side: 1, ..
+            } => "colour: axial deviation at the facet's centroid".to_string(),
+            PanelContent::Facets { parts_per_side, .. } => format!(
+                "colour: axial deviation at the centroids of a facet's {} equal parts",
+                parts_per_side * parts_per_side
+            ),
+        }
+    }
+
+    /// The panel's whole label, `title: quantity value (qualifier)`.
+    pub fn label(&self) -> String {
+        format!("{}: {}", self.title, self.rms_line())
+    }
+}
+
+/// The surface figure of a design (issues 20, 34): the designs as built
+/// (nodes) on one row, the flat facets of ours raw and about their best fit
+/// on the next, on one signed colour scale in mm.
 #[derive(Debug, Clone)]
 pub struct SurfaceFigure {
     /// The figure's title.
     pub title: String,
-    /// Node panels, left to right (the conventional design as built, then
-    /// ours).
-    pub panels: Vec<NodePanel>,
-    /// The flat facets of our design as built: plan corners, m, and the
-    /// axial deviation of the facet's centroid from the paraboloid, mm.
-    pub facets: Vec<([(f64, f64); 3], f64)>,
+    /// The panels: node panels drawn on the first row, facet panels on the
+    /// second, each row left to right in this order.
+    pub panels: Vec<SurfacePanel>,
     /// The front net's cables in plan, m.
     pub cables: Vec<[(f64, f64); 2]>,
     /// The top hinges in plan, m, in ring order.
@@ -95,18 +196,58 @@ impl DeviationScale {
 /// Cables drawn on a surface panel at most: beyond, only the colours.
 const MAX_DRAWN_CABLES: usize = 3_000;
 
-/// One plan-view panel: the truss outline, the cables, and either nodes or
-/// facets coloured by deviation.
+/// Height of a panel's label (title, RMS, colour note), px.
+const PANEL_LABEL_PX: i32 = 62;
+
+/// A panel's label, three lines: what it shows, its RMS, what a colour is.
+fn draw_panel_label<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    panel: &SurfacePanel,
+) -> Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    let centre = area.dim_in_pixel().0 as i32 / 2;
+    let centred = |size: f64, colour: RGBColor| {
+        ("sans-serif", size)
+            .into_font()
+            .color(&colour)
+            .pos(plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Center,
+                plotters::style::text_anchor::VPos::Top,
+            ))
+    };
+    area.draw(&Text::new(
+        panel.title.clone(),
+        (centre, 4),
+        centred(17.0, BLACK),
+    ))?;
+    area.draw(&Text::new(
+        panel.rms_line(),
+        (centre, 25),
+        centred(16.0, BLACK),
+    ))?;
+    area.draw(&Text::new(
+        panel.colour_note(),
+        (centre, 45),
+        centred(13.0, RGBColor(90, 90, 90)),
+    ))?;
+    Ok(())
+}
+
+/// One plan-view panel: its label, the truss outline, the cables, and its
+/// nodes or facets coloured by deviation.
 fn draw_surface_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     figure: &SurfaceFigure,
-    title: &str,
-    nodes: Option<&[(f64, f64, f64)]>,
+    panel: &SurfacePanel,
     scale: DeviationScale,
 ) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
 {
+    let (label, plot) = area.split_vertically(PANEL_LABEL_PX);
+    draw_panel_label(&label, panel)?;
     let (mut lo, mut hi) = (
         (f64::INFINITY, f64::INFINITY),
         (f64::NEG_INFINITY, f64::NEG_INFINITY),
@@ -120,8 +261,7 @@ where
     }
     let half = 0.55 * (hi.0 - lo.0).max(hi.1 - lo.1).max(1e-9);
     let centre = (0.5 * (lo.0 + hi.0), 0.5 * (lo.1 + hi.1));
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 17))
+    let mut chart = ChartBuilder::on(&plot)
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(45)
@@ -136,10 +276,9 @@ where
         .y_desc("y (m)")
         .label_style(("sans-serif", 13))
         .draw()?;
-    if nodes.is_none() {
+    if let PanelContent::Facets { parts, .. } = &panel.content {
         chart.draw_series(
-            figure
-                .facets
+            parts
                 .iter()
                 .map(|(corners, d)| Polygon::new(corners.to_vec(), scale.colour(*d).filled())),
         )?;
@@ -155,7 +294,7 @@ where
                 .map(|c| PathElement::new(c.to_vec(), cable)),
         )?;
     }
-    if let Some(nodes) = nodes {
+    if let PanelContent::Nodes(nodes) = &panel.content {
         let radius = (600.0 / (nodes.len().max(1) as f64).sqrt()).clamp(1.5, 5.0) as i32;
         chart.draw_series(
             nodes
@@ -229,6 +368,39 @@ where
     Ok(())
 }
 
+/// Size of one panel, px.
+const PANEL_PX: (u32, u32) = (580, 660);
+
+/// Width of the colour bar, px.
+const BAR_PX: u32 = 170;
+
+/// Height of the figure's title, px.
+const TITLE_PX: u32 = 36;
+
+/// The figure's rows: node panels, then facet panels (a row with none is
+/// left out).
+fn rows(figure: &SurfaceFigure) -> Vec<Vec<&SurfacePanel>> {
+    let (nodes, facets): (Vec<&SurfacePanel>, Vec<&SurfacePanel>) = figure
+        .panels
+        .iter()
+        .partition(|p| matches!(p.content, PanelContent::Nodes(_)));
+    [nodes, facets]
+        .into_iter()
+        .filter(|row| !row.is_empty())
+        .collect()
+}
+
+/// The figure's size, px: the longest row's panels side by side, the rows
+/// one above the other, the title above and the colour bar to the right.
+fn figure_size(figure: &SurfaceFigure) -> (u32, u32) {
+    let rows = rows(figure);
+    let columns = rows.iter().map(Vec::len).max().unwrap_or(1) as u32;
+    (
+        PANEL_PX.0 * columns + BAR_PX,
+        PANEL_PX.1 * rows.len().max(1) as u32 + TITLE_PX,
+    )
+}
+
 fn draw_surface<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     figure: &SurfaceFigure,
@@ -239,48 +411,42 @@ where
     root.fill(&WHITE)?;
     let body = root.titled(&figure.title, ("sans-serif", 20))?;
     let width = body.dim_in_pixel().0 as i32;
-    let (plots, bar) = body.split_horizontally(width - 170);
+    let (plots, bar) = body.split_horizontally(width - BAR_PX as i32);
     let scale = DeviationScale::of(
         figure
             .panels
             .iter()
-            .flat_map(|p| p.nodes.iter().map(|n| n.2.abs()))
-            .chain(figure.facets.iter().map(|f| f.1.abs()))
+            .flat_map(|p| p.content.deviations())
+            .map(f64::abs)
             .filter(|d| d.is_finite())
             .fold(0.0, f64::max),
     );
-    let areas = plots.split_evenly((1, figure.panels.len() + 1));
-    for (panel, area) in figure.panels.iter().zip(&areas) {
-        let rms = (panel.nodes.iter().map(|n| n.2 * n.2).sum::<f64>()
-            / panel.nodes.len().max(1) as f64)
-            .sqrt();
-        let title = format!("{}: node RMS {rms:.2e} mm", panel.title);
-        draw_surface_panel(area, figure, &title, Some(&panel.nodes), scale)?;
+    let rows = rows(figure);
+    let columns = rows.iter().map(Vec::len).max().unwrap_or(1);
+    for (row, area) in rows.iter().zip(plots.split_evenly((rows.len().max(1), 1))) {
+        // A shorter row is centred under the longer one.
+        let indent = (columns - row.len()) as i32 * PANEL_PX.0 as i32 / 2;
+        let area = area.margin(0, 0, indent, indent);
+        for (panel, cell) in row.iter().zip(area.split_evenly((1, row.len()))) {
+            draw_surface_panel(&cell, figure, panel, scale)?;
+        }
     }
-    let facet_rms = (figure.facets.iter().map(|f| f.1 * f.1).sum::<f64>()
-        / figure.facets.len().max(1) as f64)
-        .sqrt();
-    draw_surface_panel(
-        &areas[figure.panels.len()],
-        figure,
-        &format!("flat facets of ours: centroid RMS {facet_rms:.2e} mm"),
-        None,
-        scale,
-    )?;
     draw_colour_bar(&bar, scale)?;
     Ok(root.present()?)
 }
 
 /// Draws the surface figure as a PNG written atomically: a plan view per
-/// design as built (nodes coloured by their axial deviation from the
-/// paraboloid), then the flat facets of ours coloured by their centroid's,
-/// all on one signed colour scale in mm, logarithmic over seven decades
-/// below the largest magnitude (red above the paraboloid, towards the focus;
-/// blue below), with the front net's cables and the ring truss (its top
-/// hinges) drawn.
+/// panel — the designs as built (free nodes coloured by their axial
+/// deviation from the paraboloid) on one row, the flat facets of ours
+/// (coloured by the axial deviation at their centroid, from the design
+/// paraboloid and from the best fit) on the next —, each labelled with its
+/// RMS, all on one signed colour scale in mm, logarithmic over seven
+/// decades below the largest magnitude (red above the paraboloid, towards
+/// the focus; blue below), with the front net's cables and the ring truss
+/// (its top hinges) drawn.
 pub fn surface_plot(figure: &SurfaceFigure, png: &Path) -> Result<(), ReportError> {
     register_font();
-    let size = (560 * (figure.panels.len() as u32 + 1) + 170, 640);
+    let size = figure_size(figure);
     let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
     draw_surface(
         BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area(),
