@@ -68,6 +68,8 @@ pub fn scaled(scene: &Scene, aperture_m: f64) -> Result<Scene, SizingError> {
     r.offset_m *= s;
     out.truss.height_m *= s;
     out.front_net.rings = ((scene.front_net.rings as f64 * s).round() as usize).max(1);
+    // Scaled, not chosen for the scene's surface target.
+    out.front_net.chosen = None;
     out.front_net.membrane_stress_n_per_m = Some(scene.front_net.mean_tension_n / per_stress);
     out.front_net.mean_tension_n = 0.0;
     out.rear_net.focal_length_m *= s;

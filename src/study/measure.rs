@@ -44,6 +44,8 @@ fn measure(
 ) -> Measurement {
     let mut scene = scene.clone();
     scene.front_net.rings = run.rings;
+    // Another net than a surface target chose, if it chose one.
+    scene.front_net.chosen = None;
     scene.truss.elements_per_rod = run.elements_per_rod;
     scene.effects.truss = run.truss;
     let settings = LoopSettings {
