@@ -1,8 +1,9 @@
 //! The `ringmesh` command line: parses arguments ([`cli`]), calls
 //! [`ringmesh::run`], prints the command's summary ([`Summary`]).
 //! Exit codes: 0 success, 1 failure, 2 bad input (nothing is written then), 3
-//! a `frame` run that ended before the full load (its results are written),
-//! 130 interrupted (SIGINT, SIGTERM, SIGHUP).
+//! a run that ended before its target — a `frame` path short of its full
+//! load, a `design` loop stopped before its tolerance — (its results are
+//! written), 130 interrupted (SIGINT, SIGTERM, SIGHUP).
 
 mod cli;
 
@@ -58,7 +59,7 @@ fn main() -> ExitCode {
             match summary.ended_early {
                 None => ExitCode::SUCCESS,
                 Some(reason) => {
-                    eprintln!("ended before the full load: {reason}");
+                    eprintln!("{reason}");
                     ExitCode::from(3)
                 }
             }

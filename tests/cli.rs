@@ -511,3 +511,38 @@ fn uniformity_at_a_huge_level_writes_finite_numbers() {
     assert!(largest > 1e299 && largest.is_finite(), "{largest:e}");
     assert!(residual <= 1e-12 * largest, "{residual:e} of {largest:e}");
 }
+
+/// A design loop stopped by its iteration budget before its tolerance is not
+/// a plain success (issue 40): exit 3, the reason on stderr, and its files
+/// written, as `frame` does short of its full load.
+#[test]
+fn a_design_loop_stopped_before_its_tolerance_exits_3_with_its_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "short");
+    let out_arg = out.to_str().unwrap();
+    let run = common::ringmesh(&[
+        "design",
+        &common::problem_arg("small-hex.toml"),
+        "--max-iterations",
+        "1",
+        "-o",
+        out_arg,
+    ]);
+    let stderr = String::from_utf8(run.stderr).unwrap();
+    assert_eq!(run.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("the design loop ended before its tolerance: max_iterations after 1"),
+        "{stderr}"
+    );
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert_eq!(report["termination"], "max_iterations");
+    // Converged, the same scene exits 0.
+    let full = common::ringmesh(&[
+        "design",
+        &common::problem_arg("small-hex.toml"),
+        "-o",
+        path(&dir, "full").to_str().unwrap(),
+    ]);
+    assert_eq!(full.status.code(), Some(0));
+}

@@ -15,6 +15,7 @@ use crate::report::{
 };
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
+use crate::status::Termination;
 use crate::surface::{PlacedParaboloid, RawAndBestFit, SurfaceBudget};
 use crate::verify::{CableModel, Verification};
 use crate::Error;
@@ -99,6 +100,16 @@ impl DesignOutcome {
             say!(s, "warning: {w}");
         }
         s.written(&self.written);
+        if r.termination != Termination::Converged {
+            s.ended_early = Some(format!(
+                "the design loop ended before its tolerance: {} after {} outer iterations, \
+                 boundary residual {} m against {} m (files written)",
+                json_name(&r.termination),
+                r.outer_iterations,
+                readable(r.boundary_residual_m, 4),
+                readable(r.tolerance_m, 4)
+            ));
+        }
         s
     }
 }

@@ -133,7 +133,7 @@ impl FrameOutput {
     pub fn ended_early(&self) -> Option<String> {
         match self.termination {
             StaticTermination::Converged => None,
-            ref t => Some(t.to_string()),
+            ref t => Some(format!("ended before the full load: {t}")),
         }
     }
 }

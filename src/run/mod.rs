@@ -67,8 +67,9 @@ pub struct Summary {
     /// entry may itself hold several lines).
     pub lines: Vec<String>,
     /// Why a run that wrote its results ended before its target (a `frame`
-    /// run short of the full load), or `None` when it reached it. The CLI
-    /// exits 3 then.
+    /// run short of the full load, a design loop stopped before its
+    /// tolerance), as the sentence the CLI prints on stderr before it exits
+    /// 3; `None` when it reached it.
     pub ended_early: Option<String>,
 }
 
