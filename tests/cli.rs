@@ -546,3 +546,44 @@ fn a_design_loop_stopped_before_its_tolerance_exits_3_with_its_files() {
     ]);
     assert_eq!(full.status.code(), Some(0));
 }
+
+/// `optimize` holds both nets' mean tensions, as `design` does (issue 40
+/// item 6: the rear net was at 138.5 N for small-hex's 140 N), whatever the
+/// solver.
+#[test]
+fn optimize_holds_the_scene_mean_tensions_of_both_nets() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = common::scene("small-hex");
+    for solver in ["lp", "least-squares"] {
+        let out = path(&dir, solver);
+        let run = common::ringmesh(&[
+            "optimize",
+            &common::problem_arg("small-hex.toml"),
+            "--solver",
+            solver,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(run.status.success(), "{solver}: {run:?}");
+        let csv = std::fs::read_to_string(out.join("cables.csv")).unwrap();
+        let mean = |group: &str| {
+            let t: Vec<f64> = csv
+                .lines()
+                .skip(1)
+                .filter(|l| l.split(',').nth(1) == Some(group))
+                .map(|l| l.split(',').nth(5).unwrap().parse::<f64>().unwrap())
+                .collect();
+            t.iter().sum::<f64>() / t.len() as f64
+        };
+        for (group, target) in [
+            ("front", scene.front_net.mean_tension_n),
+            ("rear", scene.rear_net.mean_tension_n),
+        ] {
+            let m = mean(group);
+            assert!(
+                (m - target).abs() <= 1e-9 * target,
+                "{solver}: {group} {m} N"
+            );
+        }
+    }
+}

@@ -1,16 +1,18 @@
-//! `ringmesh optimize`: one uniformity design of a scene's front net for its
-//! theoretical boundary (no truss).
+//! `ringmesh optimize`: one design of a scene's nets for its theoretical
+//! boundary (no truss): the two-stage design of the design loop's iteration
+//! 0, both nets at the scene's mean tensions.
 
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use super::{default_output_dir, read_scene, Summary};
-use crate::design::{default_solver, scene_problem};
+use crate::design::{default_solver, SceneNets};
 use crate::report::{
     cables_csv, json_name, readable, write_atomic, write_json, OutputSet, WithRun,
 };
 use crate::resources::{check_scene, SceneCommand};
+use crate::truss::layout_points;
 use crate::uniformity::{Design, SolverKind};
 use crate::Error;
 
@@ -84,10 +86,17 @@ pub fn optimize(
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     check_scene(&scene, SceneCommand::Optimize, 1)?;
     let set = OutputSet::begin(&dir, &["design.json", "cables.csv"])?;
-    let (mesh, problem) = scene_problem(&scene)?;
+    // The two-stage design `design` makes at its iteration 0 (front net by
+    // the solver, rear net by its plan balance), so both nets hold the
+    // scene's mean tensions.
+    let nets = SceneNets::new(&scene)?;
     let solver = solver.unwrap_or_else(|| default_solver(&scene));
-    let design = solver.build(None).solve(&problem)?.feasible()?;
-    let csv = cables_csv(&mesh.network, &design, &scene.cables);
+    let boundary = layout_points(&nets.mesh.truss);
+    let tied = nets.nets.design(solver.build(None).as_ref(), &boundary)?;
+    let mut design = tied.design.feasible()?;
+    // The path the solver took is the first stage's.
+    design.route = design.route.or(tied.front.route);
+    let csv = cables_csv(&nets.mesh.network, &design, &scene.cables);
     write_atomic(&set.path("cables.csv"), csv.as_bytes())?;
     let run = set.seal()?;
     let file = DesignFile {
