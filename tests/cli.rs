@@ -587,3 +587,33 @@ fn optimize_holds_the_scene_mean_tensions_of_both_nets() {
         }
     }
 }
+
+/// A refusal after the output folder is locked leaves no empty folder the
+/// run created (issue 40 item 12), and keeps a folder that was there.
+#[test]
+fn a_refused_run_leaves_no_folder_it_created() {
+    let dir = tempfile::tempdir().unwrap();
+    let fresh = path(&dir, "S");
+    let refuse = |out: &Path| {
+        common::ringmesh(&[
+            "size",
+            &common::problem_arg("small-hex.toml"),
+            "--margin",
+            "0",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let run = refuse(&fresh);
+    assert_eq!(run.status.code(), Some(2), "{run:?}");
+    assert!(!fresh.exists(), "an empty {} was left", fresh.display());
+    let existing = path(&dir, "kept");
+    std::fs::create_dir(&existing).unwrap();
+    assert_eq!(refuse(&existing).status.code(), Some(2));
+    assert!(existing.is_dir());
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(leftovers, vec![std::ffi::OsString::from("kept")]);
+}

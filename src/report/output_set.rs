@@ -69,6 +69,9 @@ pub struct OutputSet {
     /// Holds the target folder's lock while the set lives.
     _lock: File,
     committed: bool,
+    /// Whether this run created the target folder: a refusal after `begin`
+    /// then leaves no empty folder behind.
+    created: bool,
 }
 
 impl OutputSet {
@@ -85,6 +88,7 @@ impl OutputSet {
         for name in names {
             check_name(name)?;
         }
+        let created = fs::symlink_metadata(dir).is_err();
         fs::create_dir_all(dir).map_err(unwritable_at(dir))?;
         let target = fs::canonicalize(dir).map_err(unwritable_at(dir))?;
         let (Some(parent), Some(folder)) = (target.parent(), target.file_name()) else {
@@ -123,6 +127,7 @@ impl OutputSet {
             run_id,
             _lock: lock,
             committed: false,
+            created,
         })
     }
 
@@ -268,6 +273,10 @@ impl Drop for OutputSet {
         if !self.committed {
             let _ = fs::remove_dir_all(&self.staging);
             unregister(&self.staging);
+            if self.created {
+                // Only if still empty: a file another writer put there stays.
+                let _ = fs::remove_dir(&self.target);
+            }
         }
     }
 }
