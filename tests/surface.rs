@@ -194,6 +194,13 @@ fn bad_surface_input_names_its_key() {
             without_rings.replace("[reflector]", "[surface]\nrms_mm = 1e-6\n\n[reflector]"),
             "surface.rms_mm",
         ),
+        // A tension and a stress both, as refused with the rings given.
+        (
+            without_rings
+                .replace("[reflector]", "[surface]\nrms_mm = 20.0\n\n[reflector]")
+                .replace("[front_net]", "[front_net]\nmembrane_stress_n_per_m = 30.0"),
+            "front_net.membrane_stress_n_per_m",
+        ),
     ] {
         let scene = dir.path().join("bad.toml");
         std::fs::write(&scene, text).unwrap();

@@ -308,7 +308,7 @@ pub fn run(
                 let first =
                     nets.design(solver.as_ref(), &crate::truss::layout_points(&mesh.truss))?;
                 return Err(
-                    match design_margin(scene_nets.truss_frame(scene), &first.design) {
+                    match design_margin(scene_nets.truss_frame(), &first.design) {
                         Err(past) => past,
                         Ok(_) => e,
                     },
@@ -321,7 +321,7 @@ pub fn run(
     let effects = &scene_nets.effects;
     // The flexible truss's frame, constructed once for the loop's oracle,
     // the margin and both assemblies.
-    let frame = outcome.truss_deforms.then(|| scene_nets.truss_frame(scene));
+    let frame = outcome.truss_deforms.then(|| scene_nets.truss_frame());
     let stage = Instant::now();
     let limit_margin = match frame {
         None => None,
@@ -346,7 +346,9 @@ pub fn run(
     let surface = budget(
         &mesh.paraboloid,
         FrontSurface {
-            designed_m: &outcome.design.nodes_xyz_m[..n_front],
+            // The design surface: the net as generated, on the paraboloid
+            // (the same net `mesh` and the choice of rings measure).
+            designed_m: &mesh.network.nodes[..n_front],
             built_m: &verification.nodes_xyz_m[..n_front],
             free: &network.fixed_mask()[..n_front]
                 .iter()

@@ -60,6 +60,8 @@ pub struct SceneNets {
     /// The ring truss's frame, constructed the first time a stage needs it
     /// ([`SceneNets::truss_frame`]) and copied to each stage after.
     frame: OnceLock<RingTrussBuilder>,
+    /// The scene the nets and the frame are made of.
+    scene: Scene,
 }
 
 impl SceneNets {
@@ -84,12 +86,13 @@ impl SceneNets {
             nets,
             effects,
             frame: OnceLock::new(),
+            scene: scene.clone(),
         })
     }
 
     /// One run of the outer loop (net design ⇄ truss response) with a fresh
     /// truss oracle of `model` (the scene's truss values), calling `observe`
-    /// after every iteration.
+    /// after every iteration; `scene` is the scene these nets were made of.
     ///
     /// # Errors
     /// A truss that cannot be built, or the loop's errors.
@@ -101,16 +104,19 @@ impl SceneNets {
         settings: &LoopSettings,
         observe: &mut dyn FnMut(&IterationRecord),
     ) -> Result<LoopOutcome, DesignError> {
-        let mut oracle =
-            oracle_on_frame(model, &self.mesh.truss, || self.truss_frame(scene).clone())?;
+        debug_assert!(
+            scene.truss == self.scene.truss,
+            "the loop's scene is the one these nets were made of"
+        );
+        let mut oracle = oracle_on_frame(model, &self.mesh.truss, || self.truss_frame().clone())?;
         design_loop(&self.nets, solver, oracle.as_mut(), settings, observe)
     }
 
-    /// The frame of `scene`'s ring truss on this mesh's layout, with the
-    /// scene's effects: constructed once (the first call), for the loop's
-    /// oracle, the limit margin and every assembly.
-    pub fn truss_frame(&self, scene: &Scene) -> &RingTrussBuilder {
+    /// The frame of the scene's ring truss on this mesh's layout, with the
+    /// effects: constructed once (the first call), for the loop's oracle, the
+    /// limit margin and every assembly.
+    pub fn truss_frame(&self) -> &RingTrussBuilder {
         self.frame
-            .get_or_init(|| RingTruss::builder(scene, &self.mesh.truss, &self.effects))
+            .get_or_init(|| RingTruss::builder(&self.scene, &self.mesh.truss, &self.effects))
     }
 }

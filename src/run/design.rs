@@ -96,7 +96,7 @@ impl DesignOutcome {
             t.conventional_s,
             t.writing_s
         );
-        for w in &r.net.warnings {
+        for w in r.net.warnings.iter().chain(&r.surface.warnings) {
             say!(s, "warning: {w}");
         }
         s.written(&self.written);

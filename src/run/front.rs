@@ -12,7 +12,7 @@ use crate::report::{
 use crate::resources::{check_memory, check_scene, SceneCommand};
 use crate::shard::Shard;
 use crate::study;
-use crate::surface::design_surface_facets;
+use crate::surface::design_surface_facet_rms_mm;
 use crate::uniformity::{design_front_points, front_jobs, FrontPoint, SolverKind};
 use crate::Error;
 
@@ -104,7 +104,7 @@ pub fn front(
     let rms = match rms {
         RmsAxis::Design => FrontRms::Design,
         RmsAxis::Total => FrontRms::Total {
-            facets_mm: design_surface_facets(&mesh)?.raw_mm,
+            facets_mm: design_surface_facet_rms_mm(&mesh)?,
         },
     };
     // The front's solves need the problem alone.

@@ -13,7 +13,7 @@ use crate::resources::{check_scene, SceneCommand};
 use crate::scene::{Scene, TrussModel};
 use crate::shard::Shard;
 use crate::study::{self, Knob, StudyRow, StudySettings};
-use crate::surface::design_surface_facets;
+use crate::surface::design_surface_facet_rms_mm;
 use crate::uniformity::SolverKind;
 use crate::Error;
 
@@ -275,7 +275,7 @@ fn design_surface_facets_by_rings(
         .map(|r| {
             let mut net = scene.clone();
             net.front_net.rings = r;
-            Ok((r, design_surface_facets(&build_mesh(&net)?)?.raw_mm))
+            Ok((r, design_surface_facet_rms_mm(&build_mesh(&net)?)?))
         })
         .collect()
 }

@@ -80,8 +80,6 @@ impl Scene {
         Ok(())
     }
 
-    /// Sets each net's mean tension from its membrane stress, where the file
-    /// gives that instead (`validate` then checks the pair).
     /// The scene with its front net's rings set to `rings` (a scene whose
     /// file left them to `[surface] rms_mm`): the mean tensions that a
     /// membrane stress gives resolved for that net, and the whole validated.
@@ -103,6 +101,8 @@ impl Scene {
         Ok(self)
     }
 
+    /// Sets each net's mean tension from its membrane stress, where the file
+    /// gives that instead (`validate` then checks the pair).
     fn resolve_tensions(&mut self) {
         let per_unit_stress = membrane_tension_n(self, 1.0);
         for (mean, stress) in [

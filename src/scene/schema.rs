@@ -189,7 +189,7 @@ fn default_elements_per_rod() -> usize {
 #[serde(deny_unknown_fields)]
 pub struct FrontNet {
     /// Subdivisions of each sector's radial edge (rings of the grid); absent
-    /// (0) when `[surface] rms_mm` is to choose them
+    /// (or 0, read as absent) when `[surface] rms_mm` is to choose them
     /// ([`FrontNet::rings_to_choose`]).
     #[serde(default)]
     pub rings: usize,

@@ -115,8 +115,8 @@ impl Scene {
         if f.rings_to_choose() && target.is_none() {
             return Err(SceneError::invalid(
                 "front_net.rings",
-                "missing: give the rings, or `[surface] rms_mm` to choose the coarsest net \
-                 that holds it"
+                "missing (or 0): give the rings (at least 2), or `[surface] rms_mm` to \
+                 choose the coarsest net that holds it"
                     .to_string(),
             ));
         }
@@ -251,6 +251,13 @@ fn one_tension_of(
         Some(n) => {
             positive(stress_key, n)?;
             let Some(tension_per_stress) = tension_per_stress else {
+                // The rings are still to choose: the stress alone, as given.
+                if mean_tension_n != 0.0 {
+                    return Err(SceneError::invalid(
+                        stress_key,
+                        format!("give either `{mean_key}` or `{stress_key}`, not both"),
+                    ));
+                }
                 return Ok(());
             };
             let resolved = n * tension_per_stress;

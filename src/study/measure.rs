@@ -42,10 +42,19 @@ fn measure(
     max_iterations: usize,
     judge_elements: usize,
 ) -> Measurement {
-    let mut scene = scene.clone();
-    scene.front_net.rings = run.rings;
-    // Another net than a surface target chose, if it chose one.
-    scene.front_net.chosen = None;
+    // The point's net, its tensions resolved for it as for any scene (a
+    // membrane stress follows the spacing).
+    let mut scene = match scene.clone().with_rings(run.rings) {
+        Ok(s) => s,
+        Err(e) => {
+            return Measurement {
+                time_s: 0.0,
+                designed: None,
+                judged: None,
+                error: Some(e.to_string()),
+            }
+        }
+    };
     scene.truss.elements_per_rod = run.elements_per_rod;
     scene.effects.truss = run.truss;
     let settings = LoopSettings {

@@ -10,6 +10,8 @@ use super::SurfaceError;
 use crate::geometry::Paraboloid;
 use serde::Serialize;
 
+use crate::status::Termination;
+
 /// Gauss–Newton iterations before the fit is declared not converged (a fit
 /// from the design paraboloid converges in a handful: the deviations are
 /// small against the focal length).
@@ -40,6 +42,11 @@ pub struct BestFit {
     /// Gauss–Newton iterations taken (0 when the surface is the design
     /// paraboloid to rounding).
     pub iterations: usize,
+    /// How the fit ended: converged, or stopped (its iteration budget spent,
+    /// or no step lowering the RMS) at the best paraboloid it had found —
+    /// every accepted step lowers the RMS, so `rms` is then an upper bound
+    /// of the best fit's, still at most the raw RMS.
+    pub termination: Termination,
 }
 
 /// **Best-fit node RMS**: [`super::node_rms`] about the paraboloid that fits
@@ -207,14 +214,16 @@ fn fit(paraboloid: &Paraboloid, samples: &Samples) -> Result<BestFit, SurfaceErr
     let floor = ROUNDING_FLOOR * f64::EPSILON * samples.scale_m().max(paraboloid.focal_length_m);
     let mut x = to_vector(&PlacedParaboloid::design(paraboloid));
     let mut objective = mean_square(&x, samples);
-    let done = |x: &[f64; 6], iterations| {
+    let ended = |x: &[f64; 6], iterations, termination| {
         let placed = from_vector(x);
         Ok(BestFit {
             paraboloid: placed,
             rms: rms_about(&placed, samples),
             iterations,
+            termination,
         })
     };
+    let done = |x: &[f64; 6], iterations| ended(x, iterations, Termination::Converged);
     for iteration in 1..=MAX_ITERATIONS {
         if objective.sqrt() <= floor {
             return done(&x, iteration - 1);
@@ -265,19 +274,13 @@ fn fit(paraboloid: &Paraboloid, samples: &Samples) -> Result<BestFit, SurfaceErr
             if moved <= 1e-8 * objective + floor * floor {
                 return done(&x, iteration);
             }
-            return Err(SurfaceError::FitNotConverged {
-                iterations: iteration,
-                half_path_rms_m: objective.sqrt(),
-            });
+            return ended(&x, iteration, Termination::Stalled);
         }
         if before - objective <= STALL_TOLERANCE * before {
             return done(&x, iteration);
         }
     }
-    Err(SurfaceError::FitNotConverged {
-        iterations: MAX_ITERATIONS,
-        half_path_rms_m: objective.sqrt(),
-    })
+    ended(&x, MAX_ITERATIONS, Termination::MaxIterations)
 }
 
 #[cfg(test)]

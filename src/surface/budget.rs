@@ -34,6 +34,7 @@ use super::{
 };
 use crate::geometry::{Paraboloid, ReflectorMesh};
 use crate::scene::{ChosenRings, SurfaceSpec};
+use crate::status::Termination;
 
 /// An axial RMS raw and about its best-fit paraboloid, mm.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -95,6 +96,9 @@ pub struct SurfaceBudget {
     pub frequency_ghz: Option<f64>,
     /// Ruze's gain loss at it, dB (positive).
     pub gain_loss_db: Option<f64>,
+    /// Best fits that stopped before converging (their RMS is then an upper
+    /// bound of the best fit's: [`BestFit::termination`]).
+    pub warnings: Vec<String>,
 }
 
 /// Facet RMS of a mesh's front net as generated (its design surface: nodes
@@ -105,6 +109,16 @@ pub struct SurfaceBudget {
 pub fn design_surface_facets(mesh: &ReflectorMesh) -> Result<RawAndBestFit, SurfaceError> {
     let nodes = &mesh.network.nodes[..mesh.n_front_nodes];
     facets_about(&mesh.paraboloid, nodes, &mesh.front_triangles).map(|(rms, _)| rms)
+}
+
+/// Facet RMS of a mesh's front net as generated (its design surface), axial
+/// and raw, mm: [`design_surface_facets`] without the fit.
+///
+/// # Errors
+/// A net whose facets cannot be measured.
+pub fn design_surface_facet_rms_mm(mesh: &ReflectorMesh) -> Result<f64, SurfaceError> {
+    let nodes = &mesh.network.nodes[..mesh.n_front_nodes];
+    Ok(1e3 * facet_rms(&mesh.paraboloid, nodes, &mesh.front_triangles)?.axial_m)
 }
 
 /// Facet RMS of `nodes`' facets raw and best fit, and the fit.
@@ -137,7 +151,7 @@ pub fn budget(
     chosen: Option<&ChosenRings>,
 ) -> Result<SurfaceBudget, SurfaceError> {
     let mm = |m: f64| 1e3 * m;
-    let (facets, _) = facets_about(paraboloid, surface.designed_m, surface.triangles)?;
+    let (facets, design_fit) = facets_about(paraboloid, surface.designed_m, surface.triangles)?;
     let (facets_as_built, fit) = facets_about(paraboloid, surface.built_m, surface.triangles)?;
     let free: Vec<[f64; 3]> = surface
         .built_m
@@ -146,10 +160,26 @@ pub fn budget(
         .filter(|(_, &f)| f)
         .map(|(p, _)| *p)
         .collect();
+    let node_fit = best_fit_nodes(paraboloid, &free)?;
     let design_as_built = RawAndBestFit {
         raw_mm: mm(node_rms(paraboloid, &free)?.axial_m),
-        best_fit_mm: mm(best_fit_nodes(paraboloid, &free)?.rms.axial_m),
+        best_fit_mm: mm(node_fit.rms.axial_m),
     };
+    let warnings = [
+        ("facets (design surface)", &design_fit),
+        ("design as built", &node_fit),
+        ("facets as built", &fit),
+    ]
+    .iter()
+    .filter(|(_, f)| f.termination != Termination::Converged)
+    .map(|(term, f)| {
+        format!(
+            "the best fit of the {term} stopped ({:?} after {} iterations): its RMS is an \
+             upper bound",
+            f.termination, f.iterations
+        )
+    })
+    .collect();
     let half_path_best_fit_mm = mm(fit.rms.half_path_m);
     let gain_loss_db = spec
         .frequency_ghz
@@ -168,5 +198,6 @@ pub fn budget(
         best_fit: fit.paraboloid,
         frequency_ghz: spec.frequency_ghz,
         gain_loss_db,
+        warnings,
     })
 }

@@ -55,17 +55,6 @@ pub enum SurfaceError {
         /// Number of points (nodes, or quadrature points of the facets).
         n_samples: usize,
     },
-    /// The Gauss–Newton fit of the paraboloid did not converge.
-    #[error(
-        "the best-fit paraboloid did not converge in {iterations} iterations \
-         (RMS half-path-length error {half_path_rms_m:e} m)"
-    )]
-    FitNotConverged {
-        /// Gauss–Newton iterations taken.
-        iterations: usize,
-        /// RMS half-path-length error about the last iterate, m.
-        half_path_rms_m: f64,
-    },
     /// A target RMS that is not a positive number.
     #[error("target RMS {rms_m} m: must be finite and positive")]
     Target {
@@ -95,7 +84,7 @@ pub enum SurfaceError {
     /// Even the finest net allowed misses the target.
     #[error(
         "`surface.rms_mm` = {} mm: no net up to {rings} rings (the finest this scene's \
-         generator makes) meets it: {rings} rings give a facet RMS of {} mm",
+         generator makes and the memory limit allows) meets it: {rings} rings give a facet RMS of {} mm",
         nanometres(*target_rms_m), nanometres(*facet_rms_m)
     )]
     TargetNotMet {
@@ -130,12 +119,18 @@ fn nanometres(m: f64) -> f64 {
 }
 
 impl SurfaceError {
-    /// True when the error is the caller's input; false for a fit that does
-    /// not converge or a search whose premise fails.
+    /// True when the error is the caller's input: the input checks of the
+    /// public entry points (a target, a band, a range of rings, a scene); the
+    /// rest arise on computed geometry (a built surface, a fit) or a search
+    /// whose premise fails, and are not the user's.
     pub fn is_bad_input(&self) -> bool {
-        !matches!(
+        matches!(
             self,
-            SurfaceError::FitNotConverged { .. } | SurfaceError::NotMonotone { .. }
+            SurfaceError::Target { .. }
+                | SurfaceError::Frequency { .. }
+                | SurfaceError::RingsRange { .. }
+                | SurfaceError::TargetNotMet { .. }
+                | SurfaceError::Scene(_)
         )
     }
 }

@@ -60,7 +60,10 @@ mod rms;
 mod samples;
 
 pub use best_fit::{best_fit_facets, best_fit_nodes, BestFit};
-pub use budget::{budget, design_surface_facets, FrontSurface, RawAndBestFit, SurfaceBudget};
+pub use budget::{
+    budget, design_surface_facet_rms_mm, design_surface_facets, FrontSurface, RawAndBestFit,
+    SurfaceBudget,
+};
 pub use error::SurfaceError;
 pub use gain::{ruze_gain_loss_db, ruze_gain_ratio, SPEED_OF_LIGHT_M_PER_S};
 pub use net_choice::{

@@ -5,6 +5,7 @@
 use super::rms::{check_paraboloid, facet_rms, Deviation};
 use super::SurfaceError;
 use crate::geometry::{build_mesh, Paraboloid, ReflectorMesh, MAX_NODES, MIN_CABLE_LENGTH_RATIO};
+use crate::resources::{check_scene, SceneCommand};
 use crate::scene::{ChosenRings, Scene};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -210,6 +211,35 @@ pub fn max_front_rings(scene: &Scene) -> usize {
     by_nodes.min(by_cables).max(1)
 }
 
+/// The most rings, up to `most`, whose net `mesh` may build within the
+/// memory limit ([`check_scene`]): a search for a target never builds a net
+/// the run could not hold (at least 2, which the run's own check then refuses
+/// if even they do not fit).
+fn rings_within_memory(scene: &Scene, most: usize) -> usize {
+    let fits = |rings: usize| {
+        let mut trial = scene.clone();
+        trial.front_net.rings = rings;
+        check_scene(&trial, SceneCommand::Mesh, 1).is_ok()
+    };
+    if fits(most) {
+        return most;
+    }
+    let (mut lo, mut hi) = (2, most);
+    if !fits(lo) {
+        return lo;
+    }
+    // fits(lo), !fits(hi).
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 /// [`choose_rings`] for `scene`'s front net: the scene's own net generator
 /// ([`build_mesh`], nodes on the design paraboloid) at each ring count
 /// from 2 (the fewest with free boundary nodes) to [`max_front_rings`], the
@@ -229,7 +259,7 @@ pub fn choose_front_rings(
         &paraboloid,
         target_rms_m,
         deviation,
-        2..=max_front_rings(scene),
+        2..=rings_within_memory(scene, max_front_rings(scene)),
         |rings| {
             // The scene with these rings, its tensions resolved for them.
             let trial = scene.clone().with_rings(rings)?;

@@ -96,8 +96,8 @@ pub fn node_rms(paraboloid: &Paraboloid, nodes_m: &[[f64; 3]]) -> Result<Surface
 /// Gauss product of 36 points, exact to degree 10). The normal and
 /// half-path deviations multiply it by `cos α` and `cos² α`, smooth functions
 /// of `r²/(4F²)`; the same rule integrates their squares to 1e-9 relative on
-/// facets of 0.8 F, the largest the crate's nets make against F (checked
-/// against 4·10⁴ samples a facet).
+/// facets of 0.8 F (checked against 4·10⁴ samples a facet) and to about 6e-8
+/// on facets of 1.6 F (paper-26m at 2 rings, the coarsest net a study makes).
 ///
 /// With its corners on the paraboloid a facet of squared plan sides `a, b, c`
 /// deviates axially by `Σᵢ<ⱼ λᵢλⱼ ℓᵢⱼ²/(4F)`, whence exactly
