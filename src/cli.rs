@@ -28,10 +28,10 @@ pub struct Cli {
 /// `8G`, `512M`, `64K` or a number of bytes.
 fn parse_bytes(text: &str) -> Result<u64, String> {
     let text = text.trim();
-    let (number, unit) = match text.char_indices().find(|(_, c)| c.is_ascii_alphabetic()) {
-        Some((i, _)) => (&text[..i], text[i..].to_ascii_uppercase()),
-        None => (text, String::new()),
-    };
+    // The unit is the trailing letters, so that a number may have an
+    // exponent (`1.5e3M`).
+    let number = text.trim_end_matches(|c: char| c.is_ascii_alphabetic());
+    let unit = text[number.len()..].to_ascii_uppercase();
     let scale: u64 = match unit.trim_end_matches("IB").trim_end_matches('B') {
         "" => 1,
         "K" => 1 << 10,

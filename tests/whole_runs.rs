@@ -315,6 +315,12 @@ fn a_run_beyond_the_memory_limit_is_refused_before_computing() {
         &["design", scene, "-o", out_arg, "--max-memory", "lots"],
         &["--max-memory"],
     );
+    // A size with an exponent is a size (issue 40 item 9: `1.5e3M` read as
+    // an unknown unit): 1.5e-3M is 1.5 kB, far below the design's estimate.
+    refused(
+        &["design", scene, "-o", out_arg, "--max-memory", "1.5e-3M"],
+        &["allowed by --max-memory"],
+    );
 }
 
 /// The cantilever benchmark with `from` replaced by `to`, run by `frame`
