@@ -617,3 +617,26 @@ fn a_refused_run_leaves_no_folder_it_created() {
         .collect();
     assert_eq!(leftovers, vec![std::ffi::OsString::from("kept")]);
 }
+
+/// An aperture given twice is refused, naming `apertures`, before any work
+/// (issue 40 item 8: it was sized and designed twice).
+#[test]
+fn an_aperture_given_twice_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "ap");
+    let run = common::ringmesh(&[
+        "apertures",
+        &common::problem_arg("small-hex.toml"),
+        "--apertures",
+        "6,6",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8(run.stderr).unwrap();
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("`apertures`: 6 m is given twice"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}

@@ -167,6 +167,16 @@ pub fn run_aperture_study(
             reason: "no aperture given".into(),
         });
     }
+    // Each aperture once: a repeated one would size and design the same
+    // reflector twice (and write its scene twice).
+    for (k, d) in settings.apertures_m.iter().enumerate() {
+        if settings.apertures_m[..k].contains(d) {
+            return Err(SizingError::Scene {
+                key: "apertures",
+                reason: format!("{d} m is given twice"),
+            });
+        }
+    }
     let scenes = settings
         .apertures_m
         .iter()
