@@ -640,3 +640,25 @@ fn an_aperture_given_twice_is_refused() {
     );
     assert!(!out.exists());
 }
+
+/// A study's rings too many for the machine are refused up front, naming
+/// them, like the scene's own (issue 40 item 8: a failed row and exit 0).
+#[test]
+fn a_study_of_rings_beyond_memory_is_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = path(&dir, "st");
+    let run = common::ringmesh(&[
+        "study",
+        &common::problem_arg("small-hex.toml"),
+        "--knobs",
+        "rings",
+        "--rings",
+        "100000",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8(run.stderr).unwrap();
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("front_net.rings = 100000"), "{stderr}");
+    assert!(!out.exists());
+}

@@ -199,6 +199,13 @@ pub fn study(
     // A shard writes one file under the folder's lock once computed; the
     // whole study takes the folder before computing.
     check_scene(&scene, SceneCommand::Design, options.jobs.max(1) as u64)?;
+    // Each net the rings knob asks for, refused up front as the scene's own
+    // would be (not a failed row once the study has run).
+    for &rings in &settings.rings {
+        let mut net = scene.clone();
+        net.front_net.rings = rings;
+        check_scene(&net, SceneCommand::Design, options.jobs.max(1) as u64)?;
+    }
     let set = match shard {
         Some(_) => None,
         None => Some(OutputSet::begin(&dir, &FILES)?),
