@@ -124,11 +124,34 @@ pub enum SceneCommand {
     Design,
 }
 
-/// Checks `command`'s workload on `scene`, naming `front_net.rings`.
+/// Checks `command`'s workload on `scene`, naming `front_net.rings`;
+/// `parallel` designs at once (the machine's threads).
 ///
 /// # Errors
 /// [`MemoryError`].
 pub fn check_scene(scene: &Scene, command: SceneCommand, parallel: u64) -> Result<(), MemoryError> {
+    check_scene_as(scene, command, parallel, None)
+}
+
+/// [`check_scene`] for `jobs` designs at once set by the `--jobs` option,
+/// which the refusal then names with the net.
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_scene_jobs(
+    scene: &Scene,
+    command: SceneCommand,
+    jobs: u64,
+) -> Result<(), MemoryError> {
+    check_scene_as(scene, command, jobs, Some("--jobs"))
+}
+
+fn check_scene_as(
+    scene: &Scene,
+    command: SceneCommand,
+    parallel: u64,
+    parallel_key: Option<&str>,
+) -> Result<(), MemoryError> {
     let what = format!(
         "{} nodes{}",
         scene_nodes(scene),
@@ -138,9 +161,16 @@ pub fn check_scene(scene: &Scene, command: SceneCommand, parallel: u64) -> Resul
             String::new()
         }
     );
+    // What the user can lower: the net, and the option that runs designs
+    // at once.
     let key = format!(
-        "front_net.rings = {} with truss.bays = {}",
-        scene.front_net.rings, scene.truss.bays
+        "front_net.rings = {} with truss.bays = {}{}",
+        scene.front_net.rings,
+        scene.truss.bays,
+        match parallel_key {
+            Some(k) if parallel > 1 => format!(" and {k} {parallel}"),
+            _ => String::new(),
+        }
     );
     check_memory(
         &key,

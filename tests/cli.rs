@@ -662,3 +662,23 @@ fn a_study_of_rings_beyond_memory_is_refused_up_front() {
     assert!(stderr.contains("front_net.rings = 100000"), "{stderr}");
     assert!(!out.exists());
 }
+
+/// A study refused for its `--jobs` names them beside the net (issue 40
+/// item 9: the refusal blamed the net alone).
+#[test]
+fn a_study_refused_for_its_jobs_names_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = common::ringmesh(&[
+        "study",
+        &common::problem_arg("small-hex.toml"),
+        "--jobs",
+        "1024",
+        "--max-memory",
+        "1G",
+        "-o",
+        path(&dir, "st").to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8(run.stderr).unwrap();
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("and --jobs 1024"), "{stderr}");
+}

@@ -9,7 +9,7 @@ use crate::report::{
     readable, study_csv, study_plot, study_row, write_atomic, OutputSet, RmsAxis, StudyRms,
     STUDY_COLUMNS,
 };
-use crate::resources::{check_scene, SceneCommand};
+use crate::resources::{check_scene_jobs, SceneCommand};
 use crate::scene::{Scene, TrussModel};
 use crate::shard::Shard;
 use crate::study::{self, Knob, StudyRow, StudySettings};
@@ -198,13 +198,13 @@ pub fn study(
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     // A shard writes one file under the folder's lock once computed; the
     // whole study takes the folder before computing.
-    check_scene(&scene, SceneCommand::Design, options.jobs.max(1) as u64)?;
+    check_scene_jobs(&scene, SceneCommand::Design, options.jobs.max(1) as u64)?;
     // Each net the rings knob asks for, refused up front as the scene's own
     // would be (not a failed row once the study has run).
     for &rings in &settings.rings {
         let mut net = scene.clone();
         net.front_net.rings = rings;
-        check_scene(&net, SceneCommand::Design, options.jobs.max(1) as u64)?;
+        check_scene_jobs(&net, SceneCommand::Design, options.jobs.max(1) as u64)?;
     }
     let set = match shard {
         Some(_) => None,
