@@ -53,6 +53,15 @@ fn main() -> ExitCode {
     ringmesh::resources::set_memory_limit(cli.max_memory);
     // SIGINT, SIGTERM, SIGHUP: no staging folder or temporary file is left.
     let _ = ctrlc::set_handler(|| ringmesh::report::abandon_all_and_exit(130));
+    // A file-size limit (`ulimit -f`) then fails the write that crosses it
+    // (EFBIG), reported and cleaned up like a full disk, instead of killing
+    // the run by SIGXFSZ with its staging folder left.
+    // SAFETY: setting a signal's disposition to "ignore" before any thread
+    // that writes is started; no handler runs.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
     match dispatch(&cli.command) {
         Ok(summary) => {
             print(&summary);

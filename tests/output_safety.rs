@@ -137,3 +137,30 @@ fn only_the_atomic_writers_touch_the_file_system() {
     }
     assert!(offenders.is_empty(), "non-atomic writes: {offenders:#?}");
 }
+
+/// Under a file-size limit (`ulimit -f`) the write that crosses it fails
+/// like a full disk — exit 1 naming the file, nothing left behind — instead
+/// of SIGXFSZ killing the run with its staging folder (issue 40 item 12).
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_fails_like_a_full_disk() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 1; exec {} design {} -o out",
+            env!("CARGO_BIN_EXE_ringmesh"),
+            common::problem_arg("small-hex.toml")
+        ))
+        .current_dir(dir.path())
+        .output()
+        .expect("bash runs");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("error: writing") && stderr.contains("out/"),
+        "{stderr}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
