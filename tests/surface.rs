@@ -8,15 +8,13 @@ use std::path::Path;
 
 use ringmesh::geometry::build_mesh;
 use ringmesh::report::readable;
-use ringmesh::surface::{design_surface_facets, resolve_front_rings, ruze_gain_loss_db};
+use ringmesh::surface::{design_surface_facet_rms_mm, resolve_front_rings, ruze_gain_loss_db};
 use ringmesh::Scene;
 
 /// The facet RMS of `scene`'s design surface with `rings` rings, mm.
 fn facet_rms_mm(scene: &Scene, rings: usize) -> f64 {
     let scene = scene.clone().with_rings(rings).unwrap();
-    design_surface_facets(&build_mesh(&scene).unwrap())
-        .unwrap()
-        .raw_mm
+    design_surface_facet_rms_mm(&build_mesh(&scene).unwrap()).unwrap()
 }
 
 /// A scene whose file leaves its rings to a facet RMS target gets the
