@@ -58,7 +58,6 @@ impl Fixture {
     fn design(&self, model: TrussModel) -> LoopOutcome {
         self.nets
             .design_loop(
-                &self.scene,
                 self.solver.as_ref(),
                 model,
                 &LoopSettings::default(),

@@ -160,13 +160,7 @@ fn an_effect_defined_outside_the_crate_acts_on_the_nets_and_the_loop() {
     // The loop under the push, on the linear truss.
     let settings = LoopSettings::default();
     let outcome = pushed
-        .design_loop(
-            &scene,
-            solver.as_ref(),
-            TrussModel::Linear,
-            &settings,
-            &mut |_| {},
-        )
+        .design_loop(solver.as_ref(), TrussModel::Linear, &settings, &mut |_| {})
         .unwrap();
     assert_eq!(outcome.termination, Termination::Converged);
     let design = &outcome.design;

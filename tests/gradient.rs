@@ -370,7 +370,6 @@ fn the_design_loop_converges_with_the_gradient_solver() {
             let nets = SceneNets::new(&scene).unwrap();
             let outcome = nets
                 .design_loop(
-                    &scene,
                     solver.as_ref(),
                     TrussModel::Exact,
                     &LoopSettings::default(),

@@ -175,7 +175,6 @@ fn a_120_bay_ring_assembles_from_the_loops_truss_equilibrium() {
     let solver = SolverKind::Lp.build(None);
     let outcome = nets
         .design_loop(
-            &scene,
             solver.as_ref(),
             TrussModel::Exact,
             &LoopSettings::default(),

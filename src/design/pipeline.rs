@@ -268,11 +268,10 @@ pub fn run(
         };
         let mut history = Vec::new();
         let loop_clock = Instant::now();
-        let result =
-            scene_nets.design_loop(scene, solver.as_ref(), model, &loop_settings, &mut |r| {
-                history.push(r.clone());
-                observe(relaxation, r)
-            });
+        let result = scene_nets.design_loop(solver.as_ref(), model, &loop_settings, &mut |r| {
+            history.push(r.clone());
+            observe(relaxation, r)
+        });
         let loop_s = loop_clock.elapsed().as_secs_f64();
         if outcome.is_some() {
             timings.comparison_loops_s += loop_s;

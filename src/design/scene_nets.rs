@@ -92,22 +92,17 @@ impl SceneNets {
 
     /// One run of the outer loop (net design ⇄ truss response) with a fresh
     /// truss oracle of `model` (the scene's truss values), calling `observe`
-    /// after every iteration; `scene` is the scene these nets were made of.
+    /// after every iteration.
     ///
     /// # Errors
     /// A truss that cannot be built, or the loop's errors.
     pub fn design_loop(
         &self,
-        scene: &Scene,
         solver: &dyn UniformitySolver,
         model: TrussModel,
         settings: &LoopSettings,
         observe: &mut dyn FnMut(&IterationRecord),
     ) -> Result<LoopOutcome, DesignError> {
-        debug_assert!(
-            scene.truss == self.scene.truss,
-            "the loop's scene is the one these nets were made of"
-        );
         let mut oracle = oracle_on_frame(model, &self.mesh.truss, || self.truss_frame().clone())?;
         design_loop(&self.nets, solver, oracle.as_mut(), settings, observe)
     }

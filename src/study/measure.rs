@@ -65,8 +65,7 @@ fn measure(
     let clock = Instant::now();
     let designed = SceneNets::new(&scene).and_then(|nets| {
         let solver = run.solver.build(None);
-        let outcome =
-            nets.design_loop(&scene, solver.as_ref(), run.truss, &settings, &mut |_| {})?;
+        let outcome = nets.design_loop(solver.as_ref(), run.truss, &settings, &mut |_| {})?;
         Ok((nets, outcome))
     });
     let time_s = clock.elapsed().as_secs_f64();
