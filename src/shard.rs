@@ -1,10 +1,12 @@
-//! Sweeps split across machines: `--shard I/N` runs every N-th point of a
+//! Sweeps split across machines: `--shard I/N` runs every N-th unit of a
 //! sweep starting at I, and `ringmesh merge` joins the shards' CSVs into the
 //! table the unsharded run writes.
 //!
 //! Shards are numbered from 0, as a Slurm job array's `$SLURM_ARRAY_TASK_ID`
-//! with `--array=0-(N-1)`: shard `I/N` runs the points `k` with `k mod N = I`,
-//! in the sweep's deterministic order.
+//! with `--array=0-(N-1)`: shard `I/N` runs the units `u` with `u mod N = I`,
+//! in the sweep's deterministic order. A unit is one point, or a run of
+//! consecutive points that must be computed together to come out as they do
+//! unsharded — a warm-start chain, each point starting from its neighbour.
 //!
 //! A shard's CSV (`<table>.shard-I-of-N.csv`) is the sweep's CSV with two
 //! additions: a first line `# ringmesh shard {…}` whose JSON names the
@@ -74,6 +76,25 @@ impl Shard {
         (self.index..total).step_by(self.count).collect()
     }
 
+    /// The points this shard runs, in order, when the sweep's points are
+    /// dealt in `units`: the lengths of consecutive runs of points kept
+    /// together (empty: every point is a unit of its own, as in
+    /// [`Shard::points`]).
+    pub fn points_in_units(&self, total: usize, units: &[usize]) -> Vec<usize> {
+        if units.is_empty() {
+            return self.points(total);
+        }
+        let mut start = 0;
+        let mut points = Vec::new();
+        for (u, &len) in units.iter().enumerate() {
+            if self.includes(u) {
+                points.extend(start..start + len);
+            }
+            start += len;
+        }
+        points
+    }
+
     /// The shard's file name for a table `stem` (`front`, `accuracy-vs-time`):
     /// `<stem>.shard-I-of-N.csv`.
     pub fn file_name(&self, stem: &str) -> String {
@@ -122,6 +143,24 @@ pub struct ShardHeader {
     pub settings: Value,
     /// The whole resolved scene.
     pub scene_file: Value,
+    /// How the points are dealt to shards (see [`Shard::points_in_units`]):
+    /// lengths of consecutive runs of points; empty, one unit a point.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub units: Vec<usize>,
+}
+
+impl ShardHeader {
+    /// The unit of point `k` (`None` past the sweep's end).
+    fn unit_of(&self, k: usize) -> Option<usize> {
+        if self.units.is_empty() {
+            return (k < self.points).then_some(k);
+        }
+        let mut end = 0;
+        self.units.iter().position(|&len| {
+            end += len;
+            k < end
+        })
+    }
 }
 
 /// A shard CSV read back.
@@ -278,6 +317,13 @@ pub fn read_shard(path: &Path) -> Result<ShardFile, ShardError> {
         .ok_or_else(|| format(format!("its first line does not start with {SHARD_MARK:?}")))?;
     let header: ShardHeader =
         serde_json::from_str(json).map_err(|e| format(format!("its header: {e}")))?;
+    let dealt: usize = header.units.iter().sum();
+    if !header.units.is_empty() && (dealt != header.points || header.units.contains(&0)) {
+        return Err(format(format!(
+            "its units {:?} do not deal out its {} points",
+            header.units, header.points
+        )));
+    }
     let columns = lines
         .next()
         .and_then(|l| l.strip_prefix("point,"))
@@ -289,7 +335,7 @@ pub fn read_shard(path: &Path) -> Result<ShardFile, ShardError> {
             .split_once(',')
             .and_then(|(k, row)| Some((k.parse::<usize>().ok()?, row)))
             .ok_or_else(|| format(format!("row {} has no point index", n + 1)))?;
-        if k >= header.points || !header.shard.includes(k) {
+        if !header.unit_of(k).is_some_and(|u| header.shard.includes(u)) {
             return Err(format(format!(
                 "row {} is point {k}, which is not in shard {} of a {}-point sweep",
                 n + 1,
@@ -420,6 +466,12 @@ fn merge_one(mut files: Vec<ShardFile>) -> Result<Merged, ShardError> {
                 format!(" ({} and {})", a.points, b.points),
             ));
         }
+        if a.units != b.units {
+            return Err(mismatch(
+                "units",
+                format!(" ({:?} and {:?})", a.units, b.units),
+            ));
+        }
         if first.columns != other.columns {
             return Err(mismatch("columns", String::new()));
         }
@@ -501,6 +553,24 @@ mod tests {
     }
 
     #[test]
+    fn units_go_whole_to_one_shard_and_partition_the_sweep() {
+        // A chain of four, three single points, a chain of two.
+        let units = [4, 1, 1, 1, 2];
+        let shards: Vec<Vec<usize>> = (0..2)
+            .map(|i| Shard::new(i, 2).unwrap().points_in_units(9, &units))
+            .collect();
+        assert_eq!(shards[0], vec![0, 1, 2, 3, 5, 7, 8]);
+        assert_eq!(shards[1], vec![4, 6]);
+        let mut header = header(1, 2, Value::Null);
+        (header.points, header.units) = (9, units.to_vec());
+        let owned: Vec<usize> = (0..10)
+            .filter(|&k| header.unit_of(k).is_some_and(|u| header.shard.includes(u)))
+            .collect();
+        assert_eq!(owned, shards[1]);
+        assert_eq!(Shard::WHOLE.points_in_units(3, &[]), vec![0, 1, 2]);
+    }
+
+    #[test]
     fn shard_names_are_recognised() {
         assert!(is_shard_name(Path::new("a/front.shard-0-of-3.csv")));
         assert!(is_shard_name(Path::new(
@@ -516,6 +586,7 @@ mod tests {
             scene: "s".into(),
             shard: Shard::new(index, count).unwrap(),
             points: 5,
+            units: Vec::new(),
             settings,
             scene_file: serde_json::json!({"name": "s"}),
         }

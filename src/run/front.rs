@@ -13,7 +13,7 @@ use crate::resources::{check_memory, check_scene, SceneCommand};
 use crate::shard::Shard;
 use crate::study;
 use crate::surface::design_surface_facet_rms_mm;
-use crate::uniformity::{design_front_points, front_jobs, FrontPoint, SolverKind};
+use crate::uniformity::{design_front_chains, front_chains, front_jobs, FrontPoint, SolverKind};
 use crate::Error;
 
 /// What `ringmesh front` made.
@@ -110,10 +110,21 @@ pub fn front(
     // The front's solves need the problem alone.
     drop(mesh);
     let jobs = front_jobs(&problem, solvers, points);
-    let indices = shard.unwrap_or(Shard::WHOLE).points(jobs.len());
-    let mine: Vec<(SolverKind, f64)> = indices.iter().map(|&k| jobs[k]).collect();
-    progress.start(mine.len());
-    let front = design_front_points(&problem, &mine, &|p: &FrontPoint| {
+    // A shard takes whole warm-start chains (the chains c with c mod N = I),
+    // so each of its points starts from the neighbour it has unsharded.
+    let chains = front_chains(&jobs);
+    let units: Vec<usize> = chains.iter().map(ExactSizeIterator::len).collect();
+    let indices = shard
+        .unwrap_or(Shard::WHOLE)
+        .points_in_units(jobs.len(), &units);
+    let mine: Vec<&[(SolverKind, f64)]> = shard
+        .unwrap_or(Shard::WHOLE)
+        .points(chains.len())
+        .into_iter()
+        .map(|c| &jobs[chains[c].clone()])
+        .collect();
+    progress.start(indices.len());
+    let front = design_front_chains(&problem, &mine, &|p: &FrontPoint| {
         let outcome = match &p.outcome {
             Ok(_) => format!("ratio {:.6}, RMS {:.3e} mm", p.ratio, p.rms_mm),
             Err(e) => format!("failed: {e}"),
@@ -141,7 +152,7 @@ pub fn front(
             "front",
             &scene,
             shard,
-            jobs.len(),
+            (jobs.len(), units),
             settings,
             FRONT_COLUMNS,
             &rows,

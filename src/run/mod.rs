@@ -136,7 +136,8 @@ pub fn default_output_dir(scene: &Scene) -> PathBuf {
     Path::new("results").join(&scene.name)
 }
 
-/// Writes a shard's CSV, `<stem>.shard-I-of-N.csv`, in `dir`.
+/// Writes a shard's CSV, `<stem>.shard-I-of-N.csv`, in `dir`; the sweep's
+/// `points` dealt in `units` ([`Shard::points_in_units`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn write_shard(
     dir: &Path,
@@ -144,7 +145,7 @@ pub(crate) fn write_shard(
     command: &str,
     scene: &Scene,
     shard: Shard,
-    points: usize,
+    (points, units): (usize, Vec<usize>),
     settings: serde_json::Value,
     columns: &str,
     rows: &[(usize, String)],
@@ -156,6 +157,7 @@ pub(crate) fn write_shard(
         points,
         settings,
         scene_file: serde_json::to_value(scene).expect("a scene serialises"),
+        units,
     };
     let csv = shard::shard_csv(&header, columns, rows);
     Ok(OutputSet::write_one(

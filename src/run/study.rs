@@ -240,7 +240,7 @@ pub fn study(
                 "study",
                 &scene,
                 shard,
-                total,
+                (total, Vec::new()),
                 settings,
                 STUDY_COLUMNS,
                 &lines,

@@ -1,6 +1,7 @@
 //! The design front (DESIGN §4): sweep each solver's accuracy knob and judge every
 //! design by its *actual* surface RMS from a forward solve with its `q`.
 
+use std::ops::Range;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -98,24 +99,38 @@ pub fn design_front(
     points: usize,
     on_point: &(dyn Fn(&FrontPoint) + Sync),
 ) -> Vec<FrontPoint> {
-    design_front_points(problem, &front_jobs(problem, solvers, points), on_point)
+    let jobs = front_jobs(problem, solvers, points);
+    let chains: Vec<&[(SolverKind, f64)]> =
+        front_chains(&jobs).into_iter().map(|c| &jobs[c]).collect();
+    design_front_chains(problem, &chains, on_point)
 }
 
-/// Designs the front's points `jobs`, returned in their order; `on_point` is
-/// called as each finishes (from worker threads). Each run of consecutive
-/// jobs of a solver that [`SolverKind::warm_starts`] is a chain along its
-/// knob (every other job a chain of its own): the chains run in parallel,
-/// and each point of a chain starts from its neighbour's design
-/// ([`super::UniformitySolver::solve_from`]), so that an iterative solver's
-/// front moves smoothly (and monotonically) with its knob.
-pub fn design_front_points(
+/// The chains of `jobs` (ranges of indices into it, in order): each run of
+/// consecutive jobs of a solver that [`SolverKind::warm_starts`] is one chain
+/// along its knob, every other job a chain of its own. A point of a chain
+/// starts from its neighbour's design, so a chain is the unit a shard takes
+/// whole: its points then come out as they do in the unsharded sweep.
+pub fn front_chains(jobs: &[(SolverKind, f64)]) -> Vec<Range<usize>> {
+    let mut start = 0;
+    jobs.chunk_by(|a, b| a.0 == b.0 && a.0.warm_starts())
+        .map(|chain| {
+            start += chain.len();
+            start - chain.len()..start
+        })
+        .collect()
+}
+
+/// Designs the front's `chains` (of [`front_chains`]), returned as one list
+/// in their order; `on_point` is called as each point finishes (from worker
+/// threads). The chains run in parallel, and each point of a chain starts
+/// from its neighbour's design ([`super::UniformitySolver::solve_from`]), so
+/// that an iterative solver's front moves smoothly (and monotonically) with
+/// its knob.
+pub fn design_front_chains(
     problem: &UniformityProblem,
-    jobs: &[(SolverKind, f64)],
+    chains: &[&[(SolverKind, f64)]],
     on_point: &(dyn Fn(&FrontPoint) + Sync),
 ) -> Vec<FrontPoint> {
-    let chains: Vec<&[(SolverKind, f64)]> = jobs
-        .chunk_by(|a, b| a.0 == b.0 && a.0.warm_starts())
-        .collect();
     chains
         .par_iter()
         .flat_map_iter(|chain| {

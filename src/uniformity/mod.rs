@@ -26,7 +26,7 @@ pub use crate::status::Termination;
 pub use bisection::Bisection;
 pub use design::{Design, Route, SlackNodes, TensionSpread};
 pub use front::{
-    design_front, design_front_points, front_jobs, knob_values, FrontPoint, KnobRange,
+    design_front, design_front_chains, front_chains, front_jobs, knob_values, FrontPoint, KnobRange,
 };
 pub use gradient::{FinishSettings, Gradient, History};
 pub use least_squares::LeastSquares;
