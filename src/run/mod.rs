@@ -42,7 +42,7 @@ pub use merge::{merge, MergeOutcome, MergedTable};
 pub use mesh::{mesh, MeshOutcome};
 pub use optimize::{optimize, OptimizeOutcome};
 pub use size::{section_line, size, SizeOutcome};
-pub use study::{study, StudyOptions, StudyOutcome, STUDY_STEM};
+pub use study::{study, study_rows, StudyOptions, StudyOutcome, STUDY_STEM};
 pub use truss::{truss, TrussOutcome};
 pub use uniformity::{uniformity, uniformity_of, UniformityOutcome, UniformityOutput};
 
