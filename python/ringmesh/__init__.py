@@ -185,14 +185,15 @@ class Network:
 class Equilibrium:
     """A forward solve (``ringmesh fdm``): positions (n, 3), cable lengths and
     forces (m,), reactions at the fixed nodes (k, 3) in the order of
-    ``fixed``, the largest residual at a free node (N), and the solve's own
-    wall time (s)."""
+    ``fixed``, the largest residual at a free node (N), and the library's own
+    wall times (s): the network's validation and the solve."""
 
     positions: np.ndarray
     lengths: np.ndarray
     forces: np.ndarray
     reactions: np.ndarray
     max_residual: float
+    validate_s: float
     solve_s: float
 
 

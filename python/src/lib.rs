@@ -204,6 +204,13 @@ fn network_dict(py: Python<'_>, n: Network) -> PyResult<Bound<'_, PyDict>> {
 /// `fixed`, `q`, `loads` (or None), `groups` (or None), checked for shape
 /// and dtype here and validated by the library.
 fn network_of(obj: &Bound<'_, PyAny>) -> PyResult<Network> {
+    let network = arrays_of(obj)?;
+    network.validate().or_raise()?;
+    Ok(network)
+}
+
+/// [`network_of`] before the library's validation.
+fn arrays_of(obj: &Bound<'_, PyAny>) -> PyResult<Network> {
     let get = |name: &str| obj.getattr(name);
     let optional = |name: &str| -> PyResult<Option<Bound<'_, PyAny>>> {
         let v = get(name)?;
@@ -228,7 +235,6 @@ fn network_of(obj: &Bound<'_, PyAny>) -> PyResult<Network> {
             .transpose()?,
         groups,
     };
-    network.validate().or_raise()?;
     Ok(network)
 }
 
@@ -262,14 +268,20 @@ fn validate_network(network: &Bound<'_, PyAny>) -> PyResult<()> {
 }
 
 /// Forward equilibrium (`ringmesh fdm`): positions, lengths, forces,
-/// reactions, the largest residual, and the solve's own time.
+/// reactions, the largest residual, and the library's own times: the
+/// network's validation and the solve.
 #[pyfunction]
 fn fdm<'py>(py: Python<'py>, network: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
-    let network = network_of(network)?;
-    let (eq, solve_s) = py.detach(|| {
+    let network = arrays_of(network)?;
+    let (eq, validate_s, solve_s) = py.detach(|| {
         let clock = Instant::now();
-        let solved = ringmesh::fdm::solve_network(&network);
-        (solved, clock.elapsed().as_secs_f64())
+        if let Err(e) = network.validate() {
+            return (Err(ringmesh::Error::from(e)), 0.0, 0.0);
+        }
+        let validate_s = clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
+        let solved = ringmesh::fdm::solve_network(&network).map_err(ringmesh::Error::from);
+        (solved, validate_s, clock.elapsed().as_secs_f64())
     });
     let (_, eq) = eq.or_raise()?;
     let d = PyDict::new(py);
@@ -278,6 +290,7 @@ fn fdm<'py>(py: Python<'py>, network: &Bound<'py, PyAny>) -> PyResult<Bound<'py,
     d.set_item("lengths", convert::vector_array(py, eq.edges_lengths_m))?;
     d.set_item("forces", convert::vector_array(py, eq.edges_forces_n))?;
     d.set_item("reactions", convert::rows_array(py, eq.reactions_n)?)?;
+    d.set_item("validate_s", validate_s)?;
     d.set_item("solve_s", solve_s)?;
     Ok(d)
 }
