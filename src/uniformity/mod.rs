@@ -332,3 +332,98 @@ fn overlay<T: serde::Serialize + serde::de::DeserializeOwned>(
     }
     Ok(serde_json::from_value(value).expect("checked field by field"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::ValueEnum;
+
+    fn settings(json: &str) -> serde_json::Map<String, serde_json::Value> {
+        serde_json::from_str(json).unwrap()
+    }
+
+    fn setting_error(kind: SolverKind, json: &str) -> UniformityError {
+        match kind.configure(&settings(json)) {
+            Err(e) => e,
+            Ok(s) => panic!("{} accepted {json}", s.name()),
+        }
+    }
+
+    #[test]
+    fn configure_without_settings_is_build_with_defaults() {
+        for kind in SolverKind::value_variants() {
+            let configured = kind.configure(&serde_json::Map::new()).unwrap();
+            assert_eq!(configured.name(), kind.build(None).name());
+        }
+    }
+
+    #[test]
+    fn configure_names_an_unknown_setting_and_lists_the_known_ones() {
+        match setting_error(SolverKind::Bisection, r#"{"epsilon": 0.1}"#) {
+            UniformityError::SettingValue {
+                solver,
+                name,
+                reason,
+            } => {
+                assert_eq!((solver, name.as_str()), ("bisection", "epsilon"));
+                assert!(reason.contains("epsilon_n"), "{reason}");
+            }
+            e => panic!("{e}"),
+        }
+        assert!(matches!(
+            setting_error(SolverKind::Lp, r#"{"weight": 1.0}"#),
+            UniformityError::SettingValue { name, .. } if name == "weight"
+        ));
+    }
+
+    #[test]
+    fn configure_names_a_value_of_the_wrong_type() {
+        match setting_error(SolverKind::Gradient, r#"{"weight": 2.0, "memory": 2.5}"#) {
+            UniformityError::SettingValue { name, .. } => assert_eq!(name, "memory"),
+            e => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn configure_validates_ranges_as_the_solve_would() {
+        for (kind, json, field) in [
+            (SolverKind::Bisection, r#"{"epsilon_n": -1.0}"#, "epsilon_n"),
+            (
+                SolverKind::Bisection,
+                r#"{"max_iterations": 0}"#,
+                "max_iterations",
+            ),
+            (
+                SolverKind::LeastSquares,
+                r#"{"tolerance": 2.0}"#,
+                "tolerance",
+            ),
+            (
+                SolverKind::GradientSmooth,
+                r#"{"sharpness": 0.0}"#,
+                "sharpness",
+            ),
+        ] {
+            match setting_error(kind, json) {
+                UniformityError::Setting { name, .. } => assert_eq!(name, field, "{json}"),
+                e => panic!("{json}: {e}"),
+            }
+        }
+    }
+
+    #[test]
+    fn configure_keeps_gradient_smooth_without_its_finish() {
+        // gradient-smooth is gradient with exact_finish off; a setting given
+        // by name changes that field alone.
+        let g: Gradient = overlay(
+            "gradient",
+            Gradient::smooth(),
+            &settings(r#"{"weight": 3.0, "finish": {"max_steps": 7}}"#),
+        )
+        .unwrap();
+        assert!(!g.exact_finish);
+        assert_eq!(g.weight, 3.0);
+        assert_eq!(g.finish.max_steps, 7);
+        assert_eq!(g.finish.tolerance, FinishSettings::default().tolerance);
+    }
+}
