@@ -125,3 +125,29 @@ def test_front_records_equal_the_clis_front_csv(cli, tmp_path):
     assert sorted((s["solver"], s["knob"]) for s in seen) == sorted(
         (r["solver"], r["knob"]) for r in records
     )
+
+
+def test_study_records_equal_the_clis_table(cli, tmp_path):
+    cli(
+        "study", PROBLEMS / "small-hex.toml", "--knobs", "tolerance", "--tolerances", "1e-3",
+        "-o", tmp_path,
+    )
+    with open(tmp_path / "accuracy-vs-time.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    seen = []
+    records = ringmesh.study(
+        ringmesh.Scene.from_toml(PROBLEMS / "small-hex.toml"),
+        knobs="tolerance",
+        tolerances_m=[1e-3],
+        progress=seen.append,
+    )
+    assert len(records) == len(rows) == 2  # the reference and the one point
+    assert len(seen) == len(records)
+    for r, row in zip(records, rows):
+        assert r["error"] is None and row["error"] == ""
+        assert (r["knob"], r["settings.tolerance_m"]) == (row["knob"], float(row["tolerance_m"]))
+        assert r["summary.outer_iterations"] == int(row["outer_iterations"])
+        # accuracy-vs-time.csv prints 11 significant digits of the ratios, 7 of the rest.
+        assert r["ratio"] == pytest.approx(float(row["ratio"]), rel=1e-10)
+        assert r["built_ratio"] == pytest.approx(float(row["built_ratio"]), rel=1e-10)
+        assert r["rms_mm"] == pytest.approx(float(row["rms_mm"]), rel=1e-6)
