@@ -10,10 +10,14 @@ use crate::report::{
     OutputSet, RmsAxis, FRONT_COLUMNS,
 };
 use crate::resources::{check_memory, check_scene, SceneCommand};
+use crate::scene::Scene;
 use crate::shard::Shard;
 use crate::study;
 use crate::surface::design_surface_facet_rms_mm;
-use crate::uniformity::{design_front_chains, front_chains, front_jobs, FrontPoint, SolverKind};
+use crate::uniformity::{
+    design_front, design_front_chains, front_chains, front_jobs, FrontPoint, SolverKind,
+    UniformityProblem,
+};
 use crate::Error;
 
 /// What `ringmesh front` made.
@@ -100,15 +104,7 @@ pub fn front(
         Some(_) => None,
         None => Some(OutputSet::begin(&dir, &FILES)?),
     };
-    let (mesh, problem) = scene_problem(&scene)?;
-    let rms = match rms {
-        RmsAxis::Design => FrontRms::Design,
-        RmsAxis::Total => FrontRms::Total {
-            facets_mm: design_surface_facet_rms_mm(&mesh)?,
-        },
-    };
-    // The front's solves need the problem alone.
-    drop(mesh);
+    let (problem, rms) = front_problem(&scene, rms)?;
     let jobs = front_jobs(&problem, solvers, points);
     // A shard takes whole warm-start chains (the chains c with c mod N = I),
     // so each of its points starts from the neighbour it has unsharded.
@@ -182,6 +178,47 @@ pub fn front(
         rms,
         written: paths,
     })
+}
+
+/// The design front of `scene` in memory, without files: each of `solvers`'
+/// knob swept over `points` values (as [`front`] sweeps them), and the
+/// surface RMS `rms` chooses to draw them at; `on_point` sees each point as
+/// it finishes (from the solving threads). What a library user (the Python
+/// bindings) calls.
+///
+/// # Errors
+/// A scene whose problem cannot be stated, a workload beyond the memory
+/// limit; a point that fails is a point with its error.
+pub fn front_points(
+    scene: &Scene,
+    solvers: &[SolverKind],
+    points: usize,
+    rms: RmsAxis,
+    on_point: &(dyn Fn(&FrontPoint) + Sync),
+) -> Result<(Vec<FrontPoint>, FrontRms), Error> {
+    let scene = crate::surface::resolve_front_rings(scene)?;
+    check_scene(
+        &scene,
+        SceneCommand::Optimize,
+        rayon::current_num_threads() as u64,
+    )?;
+    let (problem, rms) = front_problem(&scene, rms)?;
+    Ok((design_front(&problem, solvers, points, on_point), rms))
+}
+
+/// The problem a front of `scene` solves, and the RMS `rms` chooses to draw
+/// its points at.
+fn front_problem(scene: &Scene, rms: RmsAxis) -> Result<(UniformityProblem, FrontRms), Error> {
+    let (mesh, problem) = scene_problem(scene)?;
+    let rms = match rms {
+        RmsAxis::Design => FrontRms::Design,
+        RmsAxis::Total => FrontRms::Total {
+            facets_mm: design_surface_facet_rms_mm(&mesh)?,
+        },
+    };
+    // The front's solves need the problem alone.
+    drop(mesh);
+    Ok((problem, rms))
 }
 
 /// Memory of one point of a front beside the solves: its job, its result,

@@ -37,14 +37,14 @@ pub use frame::{
     default_frame_output, frame, FrameCounts, FrameNodeOutput, FrameOutcome, FrameOutput,
     FrameReaction,
 };
-pub use front::{front, FrontOutcome};
+pub use front::{front, front_points, FrontOutcome};
 pub use merge::{merge, MergeOutcome, MergedTable};
 pub use mesh::{mesh, MeshOutcome};
 pub use optimize::{optimize, OptimizeOutcome};
 pub use size::{section_line, size, SizeOutcome};
-pub use study::{study, StudyOptions, StudyOutcome, STUDY_STEM};
+pub use study::{study, study_rows, StudyOptions, StudyOutcome, STUDY_STEM};
 pub use truss::{truss, TrussOutcome};
-pub use uniformity::{uniformity, UniformityOutcome, UniformityOutput};
+pub use uniformity::{uniformity, uniformity_of, UniformityOutcome, UniformityOutput};
 
 use crate::report::{readable, OutputSet};
 use crate::scene::Scene;

@@ -177,6 +177,44 @@ macro_rules! stem {
     };
 }
 
+/// The settings of a study of `scene` with `options`, validated, and its
+/// workload checked against the memory limit: the scene's net and each net
+/// the rings knob asks for, refused up front (not a failed row once the
+/// study has run).
+fn study_settings(scene: &Scene, options: &StudyOptions) -> Result<StudySettings, Error> {
+    let settings = options.settings(scene);
+    settings.validate()?;
+    check_scene_jobs(scene, SceneCommand::Design, options.jobs.max(1) as u64)?;
+    for &rings in &settings.rings {
+        let mut net = scene.clone();
+        net.front_net.rings = rings;
+        check_scene_jobs(&net, SceneCommand::Design, options.jobs.max(1) as u64)?;
+    }
+    Ok(settings)
+}
+
+/// The whole study of `scene` in memory, without files: `(point index,
+/// row)` in sweep order; `on_point` sees each row as it finishes. What a
+/// library user (the Python bindings) calls.
+///
+/// # Errors
+/// Invalid options, a workload beyond the memory limit, a reference point
+/// that fails; a point that fails is a row with its error.
+pub fn study_rows(
+    scene: &Scene,
+    options: &StudyOptions,
+    on_point: &(dyn Fn(&StudyRow) + Sync),
+) -> Result<Vec<(usize, StudyRow)>, Error> {
+    let settings = study_settings(scene, options)?;
+    Ok(study::run_study(
+        scene,
+        &settings,
+        Shard::WHOLE,
+        options.jobs,
+        on_point,
+    )?)
+}
+
 /// The name of the study's table and plots.
 pub const STUDY_STEM: &str = stem!();
 
@@ -193,19 +231,10 @@ pub fn study(
     progress: &dyn Progress,
 ) -> Result<StudyOutcome, Error> {
     let scene = read_scene(scene_path)?;
-    let settings = options.settings(&scene);
-    settings.validate()?;
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     // A shard writes one file under the folder's lock once computed; the
     // whole study takes the folder before computing.
-    check_scene_jobs(&scene, SceneCommand::Design, options.jobs.max(1) as u64)?;
-    // Each net the rings knob asks for, refused up front as the scene's own
-    // would be (not a failed row once the study has run).
-    for &rings in &settings.rings {
-        let mut net = scene.clone();
-        net.front_net.rings = rings;
-        check_scene_jobs(&net, SceneCommand::Design, options.jobs.max(1) as u64)?;
-    }
+    let settings = study_settings(&scene, options)?;
     let set = match shard {
         Some(_) => None,
         None => Some(OutputSet::begin(&dir, &FILES)?),

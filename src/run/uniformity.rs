@@ -93,6 +93,37 @@ pub fn uniformity(
     output_path: &Path,
 ) -> Result<UniformityOutcome, Error> {
     let network = Network::read_json(network_path)?;
+    let output = uniformity_of(
+        network,
+        solver,
+        &serde_json::Map::new(),
+        groups,
+        mean_tension_n,
+        max_force_density_n_per_m,
+    )?;
+    write_json(output_path, &output)?;
+    Ok(UniformityOutcome {
+        output,
+        written: output_path.to_path_buf(),
+    })
+}
+
+/// The work of [`uniformity`] on a network in memory (validated here), the
+/// solver configured with `settings` ([`SolverKind::configure`]): what a
+/// library user (the Python bindings) calls.
+///
+/// # Errors
+/// An invalid network, group, setting or problem; a solver that fails or
+/// finds no feasible design.
+pub fn uniformity_of(
+    network: Network,
+    solver: Option<SolverKind>,
+    settings: &serde_json::Map<String, serde_json::Value>,
+    groups: Option<&[String]>,
+    mean_tension_n: Option<f64>,
+    max_force_density_n_per_m: f64,
+) -> Result<UniformityOutput, Error> {
+    network.validate()?;
     let default_groups = vec!["front".to_string()];
     let groups: Vec<String> = match (groups, &network.groups) {
         (Some(g), _) => g.to_vec(),
@@ -143,7 +174,7 @@ pub fn uniformity(
         max_force_density_n_per_m,
     )?;
     let solver = solver.unwrap_or_else(|| SolverKind::default_for(1, problem.has_loads()));
-    let design = solver.build(None).solve(&problem)?.feasible()?;
+    let design = solver.configure(settings)?.solve(&problem)?.feasible()?;
     let output = UniformityOutput {
         ratio: design.ratio,
         max_residual: design.max_residual_n,
@@ -161,9 +192,5 @@ pub fn uniformity(
         route: design.route,
         warnings: design.warnings,
     };
-    write_json(output_path, &output)?;
-    Ok(UniformityOutcome {
-        output,
-        written: output_path.to_path_buf(),
-    })
+    Ok(output)
 }

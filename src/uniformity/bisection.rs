@@ -29,7 +29,8 @@ enum Trial {
 }
 
 /// Ratio bisection over LP (ε = 0) or SOCP (ε > 0) feasibility.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Bisection {
     /// Allowed equilibrium residual `‖A q − p‖₂`, N (0: exact equilibrium, an LP).
     pub epsilon_n: f64,
@@ -53,6 +54,34 @@ impl Default for Bisection {
 }
 
 impl Bisection {
+    /// Checks the settings.
+    ///
+    /// # Errors
+    /// [`UniformityError::Setting`] naming the first field out of its range.
+    pub fn validate(&self) -> Result<(), UniformityError> {
+        let bad = |name: &'static str, value: f64, range: &'static str| {
+            Err(UniformityError::Setting {
+                solver: "bisection",
+                name,
+                value,
+                range,
+            })
+        };
+        if !(self.epsilon_n >= 0.0 && self.epsilon_n.is_finite()) {
+            return bad("epsilon_n", self.epsilon_n, "finite and ≥ 0");
+        }
+        if !(self.relative_tolerance > 0.0 && self.relative_tolerance < 1.0) {
+            return bad("relative_tolerance", self.relative_tolerance, "in (0, 1)");
+        }
+        if !(self.max_ratio > 1.0 && self.max_ratio.is_finite()) {
+            return bad("max_ratio", self.max_ratio, "finite and > 1");
+        }
+        if self.max_iterations == 0 {
+            return bad("max_iterations", 0.0, "≥ 1");
+        }
+        Ok(())
+    }
+
     /// The elastic program for ratio `r`: variables `[q (m), t (sets), σ]`.
     fn trial(&self, problem: &UniformityProblem, r: f64) -> super::conic::ConicOutcome {
         let lengths = problem.lengths_m();
@@ -179,14 +208,7 @@ impl UniformitySolver for Bisection {
 
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
         let start = Instant::now();
-        if !(self.epsilon_n >= 0.0 && self.epsilon_n.is_finite()) {
-            return Err(UniformityError::Setting {
-                solver: "bisection",
-                name: "epsilon_n",
-                value: self.epsilon_n,
-                range: "finite and ≥ 0",
-            });
-        }
+        self.validate()?;
         let mut warnings = Vec::new();
         let mut iterations = 0;
         let (mut lo, mut hi) = (1.0, 2.0);

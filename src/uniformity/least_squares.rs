@@ -102,7 +102,8 @@ const SHOWN: usize = 6;
 ///
 /// The design's `iterations` counts the solves with the one factorisation
 /// (refinement and proximal steps together).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct LeastSquares {
     /// Tikhonov weight λ (dimensionless: both terms are in N²), the design
     /// front's knob; `None` (or `Some(0.0)`, the λ → 0 limit) for the

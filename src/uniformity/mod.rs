@@ -92,6 +92,17 @@ pub enum UniformityError {
         /// The design's warnings, the reason among them.
         warnings: Vec<String>,
     },
+    /// A solver setting given by name that the solver does not have, or
+    /// whose value is not of its type.
+    #[error("invalid `{solver}` setting `{name}`: {reason}")]
+    SettingValue {
+        /// The solver.
+        solver: &'static str,
+        /// The setting as given.
+        name: String,
+        /// What is wrong with it (the settings it has, for an unknown one).
+        reason: String,
+    },
     /// The inner solver failed numerically (its status, verbatim).
     #[error("the `{solver}` solver failed: {status}")]
     SolverFailed {
@@ -134,6 +145,7 @@ impl UniformityError {
         match self {
             UniformityError::Invalid { .. }
             | UniformityError::Setting { .. }
+            | UniformityError::SettingValue { .. }
             | UniformityError::Unsupported { .. }
             | UniformityError::RatioLimit { .. }
             | UniformityError::Infeasible { .. } => true,
@@ -217,6 +229,52 @@ impl SolverKind {
         matches!(self, SolverKind::Gradient | SolverKind::GradientSmooth)
     }
 
+    /// The solver with `settings` over its defaults: each a field of its
+    /// settings by name (`{"epsilon_n": 0.5}` for `bisection`, `finish` a
+    /// table of the gradient finish's), validated as the solve would.
+    ///
+    /// # Errors
+    /// [`UniformityError::SettingValue`] naming a setting the solver does not
+    /// have or a value not of its type; [`UniformityError::Setting`] naming
+    /// one out of its range.
+    pub fn configure(
+        self,
+        settings: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<Box<dyn UniformitySolver>, UniformityError> {
+        let name = self.build(None).name();
+        Ok(match self {
+            SolverKind::Lp => match settings.keys().next() {
+                Some(key) => {
+                    return Err(UniformityError::SettingValue {
+                        solver: name,
+                        name: key.clone(),
+                        reason: "the `lp` solver has no settings".into(),
+                    })
+                }
+                None => Box::new(Lp),
+            },
+            SolverKind::Bisection => {
+                let b: Bisection = overlay(name, Bisection::default(), settings)?;
+                b.validate()?;
+                Box::new(b)
+            }
+            SolverKind::Gradient | SolverKind::GradientSmooth => {
+                let defaults = Gradient {
+                    exact_finish: self == SolverKind::Gradient,
+                    ..Gradient::default()
+                };
+                let g: Gradient = overlay(name, defaults, settings)?;
+                g.validate()?;
+                Box::new(g)
+            }
+            SolverKind::LeastSquares => {
+                let l: LeastSquares = overlay(name, LeastSquares::default(), settings)?;
+                l.validate()?;
+                Box::new(l)
+            }
+        })
+    }
+
     /// The solver with its default settings, or with its accuracy knob set.
     pub fn build(self, knob: Option<f64>) -> Box<dyn UniformitySolver> {
         match self {
@@ -240,5 +298,132 @@ impl SolverKind {
                 ..LeastSquares::default()
             }),
         }
+    }
+}
+
+/// `base` with the fields `settings` names replaced, each checked in turn so
+/// that an error names its setting.
+fn overlay<T: serde::Serialize + serde::de::DeserializeOwned>(
+    solver: &'static str,
+    base: T,
+    settings: &serde_json::Map<String, serde_json::Value>,
+) -> Result<T, UniformityError> {
+    let mut value = serde_json::to_value(base).expect("solver settings serialise");
+    let fields = value
+        .as_object_mut()
+        .expect("solver settings are a table of fields");
+    for (key, v) in settings {
+        if !fields.contains_key(key) {
+            let known: Vec<&str> = fields.keys().map(String::as_str).collect();
+            return Err(UniformityError::SettingValue {
+                solver,
+                name: key.clone(),
+                reason: format!("no such setting (it has {})", known.join(", ")),
+            });
+        }
+        fields.insert(key.clone(), v.clone());
+        if let Err(e) = serde_json::from_value::<T>(serde_json::Value::Object(fields.clone())) {
+            return Err(UniformityError::SettingValue {
+                solver,
+                name: key.clone(),
+                reason: e.to_string(),
+            });
+        }
+    }
+    Ok(serde_json::from_value(value).expect("checked field by field"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::ValueEnum;
+
+    fn settings(json: &str) -> serde_json::Map<String, serde_json::Value> {
+        serde_json::from_str(json).unwrap()
+    }
+
+    fn setting_error(kind: SolverKind, json: &str) -> UniformityError {
+        match kind.configure(&settings(json)) {
+            Err(e) => e,
+            Ok(s) => panic!("{} accepted {json}", s.name()),
+        }
+    }
+
+    #[test]
+    fn configure_without_settings_is_build_with_defaults() {
+        for kind in SolverKind::value_variants() {
+            let configured = kind.configure(&serde_json::Map::new()).unwrap();
+            assert_eq!(configured.name(), kind.build(None).name());
+        }
+    }
+
+    #[test]
+    fn configure_names_an_unknown_setting_and_lists_the_known_ones() {
+        match setting_error(SolverKind::Bisection, r#"{"epsilon": 0.1}"#) {
+            UniformityError::SettingValue {
+                solver,
+                name,
+                reason,
+            } => {
+                assert_eq!((solver, name.as_str()), ("bisection", "epsilon"));
+                assert!(reason.contains("epsilon_n"), "{reason}");
+            }
+            e => panic!("{e}"),
+        }
+        assert!(matches!(
+            setting_error(SolverKind::Lp, r#"{"weight": 1.0}"#),
+            UniformityError::SettingValue { name, .. } if name == "weight"
+        ));
+    }
+
+    #[test]
+    fn configure_names_a_value_of_the_wrong_type() {
+        match setting_error(SolverKind::Gradient, r#"{"weight": 2.0, "memory": 2.5}"#) {
+            UniformityError::SettingValue { name, .. } => assert_eq!(name, "memory"),
+            e => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn configure_validates_ranges_as_the_solve_would() {
+        for (kind, json, field) in [
+            (SolverKind::Bisection, r#"{"epsilon_n": -1.0}"#, "epsilon_n"),
+            (
+                SolverKind::Bisection,
+                r#"{"max_iterations": 0}"#,
+                "max_iterations",
+            ),
+            (
+                SolverKind::LeastSquares,
+                r#"{"tolerance": 2.0}"#,
+                "tolerance",
+            ),
+            (
+                SolverKind::GradientSmooth,
+                r#"{"sharpness": 0.0}"#,
+                "sharpness",
+            ),
+        ] {
+            match setting_error(kind, json) {
+                UniformityError::Setting { name, .. } => assert_eq!(name, field, "{json}"),
+                e => panic!("{json}: {e}"),
+            }
+        }
+    }
+
+    #[test]
+    fn configure_keeps_gradient_smooth_without_its_finish() {
+        // gradient-smooth is gradient with exact_finish off; a setting given
+        // by name changes that field alone.
+        let g: Gradient = overlay(
+            "gradient",
+            Gradient::smooth(),
+            &settings(r#"{"weight": 3.0, "finish": {"max_steps": 7}}"#),
+        )
+        .unwrap();
+        assert!(!g.exact_finish);
+        assert_eq!(g.weight, 3.0);
+        assert_eq!(g.finish.max_steps, 7);
+        assert_eq!(g.finish.tolerance, FinishSettings::default().tolerance);
     }
 }

@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 use crate::uniformity::UniformityError;
 
 /// Adjoint-gradient L-BFGS on the free geometry (see the module documentation).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Gradient {
     /// Weight `w` of the ratio surrogate `ln(Tmax/Tmin)` against the surface
     /// term `(RMS/ε)²`: larger buys a lower `Tmax/Tmin` with a larger surface
