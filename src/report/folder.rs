@@ -217,9 +217,7 @@ mod tests {
         assert!(!is_mount_point(&dir, &device).unwrap());
         // A mount point deeper down is not one of `dir`'s own entries: it
         // moves with the folder that holds it.
-        assert!(mount_points_in(&dir.join("b"), &device)
-            .unwrap()
-            .is_empty());
+        assert!(mount_points_in(&dir.join("b"), &device).unwrap().is_empty());
         // The real devices: one file system.
         assert!(mount_points_in(&dir, &device_of).unwrap().is_empty());
     }

@@ -49,7 +49,10 @@ impl OutputPath {
             .parent()
             .filter(|p| !p.as_os_str().is_empty())
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-        match path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()) {
+        match path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        {
             Some(e) if e == "json" => Ok(OutputPath::File { folder, name }),
             Some(e) => Err(ReportError::OutputPath {
                 path: path.to_path_buf(),
@@ -109,7 +112,8 @@ mod tests {
         let e = OutputPath::resolve(Path::new("d/frame-path.csv")).unwrap_err();
         assert!(e.is_bad_input());
         assert!(
-            e.to_string().starts_with("-o d/frame-path.csv: the command writes JSON"),
+            e.to_string()
+                .starts_with("-o d/frame-path.csv: the command writes JSON"),
             "{e}"
         );
         assert_eq!(

@@ -228,7 +228,9 @@ impl OutputSet {
                             path: target.clone(),
                         })
                     }
-                    Ok(Some(_left)) if place == parent => remove_left_staging(&entry.path(), &target),
+                    Ok(Some(_left)) if place == parent => {
+                        remove_left_staging(&entry.path(), &target)
+                    }
                     Ok(Some(_left)) => {
                         let _ = fs::remove_dir_all(entry.path());
                     }
@@ -935,5 +937,246 @@ mod tests {
             assert!(matches!(e, ReportError::Name { .. }), "{e}");
         }
         assert!(!dir.exists());
+    }
+
+    /// Every entry of `dir` and the folders below it, as relative paths.
+    fn tree(dir: &Path) -> Vec<String> {
+        let mut all = Vec::new();
+        let mut stack = vec![dir.to_path_buf()];
+        while let Some(d) = stack.pop() {
+            for e in fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                all.push(p.strip_prefix(dir).unwrap().to_string_lossy().into_owned());
+                if e.file_type().unwrap().is_dir() {
+                    stack.push(p);
+                }
+            }
+        }
+        all.sort();
+        all
+    }
+
+    /// One set of `a.csv` and `b.json` holding `text`, swapped into `dir`.
+    fn one_set(dir: &Path, text: &str) -> Result<Vec<PathBuf>, ReportError> {
+        let set = OutputSet::begin(dir, &["a.csv", "b.json"])?;
+        fs::write(set.path("a.csv"), text).unwrap();
+        fs::write(set.path("b.json"), text).unwrap();
+        set.commit()
+    }
+
+    /// Issue 40 item 3: while sets are swapped into `X` again and again, a
+    /// program that takes no lock writes plain files into `X` and into a
+    /// folder in it, and ringmesh single-file writers (`fdm -o X/f.json`)
+    /// write theirs: every file either reported written is there afterwards
+    /// with its content, the folder holds the last set, and nothing is
+    /// left beside it or in it (no staging folder, no temporary file).
+    #[test]
+    fn files_written_during_repeated_swaps_are_all_kept() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        fs::create_dir_all(dir.join("sub")).unwrap();
+        one_set(&dir, "first").unwrap();
+        let swaps = AtomicUsize::new(0);
+        // Each writer keeps pace with the swaps (no more than a few writes
+        // ahead of them), so that its writes are spread over all of them.
+        let pace = |per_swap: usize, i: usize| {
+            while swaps.load(Ordering::SeqCst) < i / per_swap {
+                std::thread::yield_now();
+            }
+        };
+        const FOREIGN: usize = 540;
+        const OURS: usize = 100;
+        let (foreign, during, failed, ours) = std::thread::scope(|scope| {
+            let foreign = scope.spawn(|| {
+                let (mut written, mut during, mut failed) = (Vec::new(), 0, Vec::new());
+                for i in 0..FOREIGN {
+                    pace(5, i);
+                    let path = if i % 3 == 0 {
+                        dir.join("sub").join(format!("g-{i}.txt"))
+                    } else {
+                        dir.join(format!("f-{i}.txt"))
+                    };
+                    let before = swaps.load(Ordering::SeqCst);
+                    match fs::write(&path, format!("foreign {i}")) {
+                        Ok(()) => written.push((path, format!("foreign {i}"))),
+                        Err(e) => failed.push(format!("{}: {e}", path.display())),
+                    }
+                    // A swap finished while the file was written.
+                    during += usize::from(swaps.load(Ordering::SeqCst) != before);
+                }
+                (written, during, failed)
+            });
+            let ringmesh = scope.spawn(|| {
+                (0..OURS)
+                    .map(|i| {
+                        pace(1, i);
+                        let name = format!("fdm-{i}.json");
+                        let path = OutputSet::write_one(&dir, &name, name.as_bytes()).unwrap();
+                        (path, name)
+                    })
+                    .collect::<Vec<_>>()
+            });
+            let mut round = 0;
+            while !(foreign.is_finished() && ringmesh.is_finished()) {
+                one_set(&dir, &format!("set {round}")).unwrap();
+                swaps.fetch_add(1, Ordering::SeqCst);
+                round += 1;
+            }
+            let (written, during, failed) = foreign.join().unwrap();
+            (written, during, failed, ringmesh.join().unwrap())
+        });
+        let swaps = swaps.into_inner();
+        let lost: Vec<_> = foreign
+            .iter()
+            .chain(&ours)
+            .filter(|(path, text)| fs::read_to_string(path).ok().as_deref() != Some(text))
+            .map(|(path, _)| path.display().to_string())
+            .collect();
+        eprintln!(
+            "{swaps} swaps; {} foreign writes ({during} met the end of a swap, {} refused to \
+             the writer: {failed:?}), {} ringmesh writes; {} lost",
+            foreign.len(),
+            failed.len(),
+            ours.len(),
+            lost.len()
+        );
+        // A write whose path was looked up in the previous folder and which
+        // creates its file after that folder is gone fails, and its writer
+        // is told (ENOENT); it is not lost.
+        assert!(foreign.len() >= 500, "{failed:?}");
+        assert!(swaps >= FOREIGN / 5, "{swaps} swaps");
+        assert!(lost.is_empty(), "lost: {lost:?}");
+        let last = format!("set {}", swaps - 1);
+        assert_eq!(fs::read_to_string(dir.join("a.csv")).unwrap(), last);
+        assert_eq!(listing(root.path()), ["X"]);
+        let left: Vec<_> = tree(&dir)
+            .into_iter()
+            .filter(|n| n.contains(".staging-") || n.ends_with(".tmp"))
+            .collect();
+        assert!(left.is_empty(), "{left:?}");
+        assert_eq!(tree(&dir).len(), 3 + foreign.len() + OURS);
+    }
+
+    /// Issue 40 item 3: sets swapped into `X` and into `X/sub` at the same
+    /// time (two runs, each again and again) all succeed, and each folder
+    /// holds its last set: the run into `X` never takes `X/sub`'s files,
+    /// nor the other way round; no staging folder is left.
+    #[test]
+    fn sets_into_a_folder_and_a_folder_in_it_never_take_each_others_files() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        let sub = dir.join("sub");
+        const ROUNDS: usize = 40;
+        std::thread::scope(|scope| {
+            let outer = scope.spawn(|| {
+                for i in 0..ROUNDS {
+                    one_set(&dir, &format!("outer {i}")).unwrap();
+                    std::thread::yield_now();
+                }
+            });
+            let inner = scope.spawn(|| {
+                for i in 0..ROUNDS {
+                    let set = OutputSet::begin(&sub, &["s.csv"]).unwrap();
+                    fs::write(set.path("s.csv"), format!("inner {i}")).unwrap();
+                    let written = set.commit().unwrap();
+                    // What the run reports written is there.
+                    assert_eq!(
+                        fs::read_to_string(&written[0]).unwrap(),
+                        format!("inner {i}")
+                    );
+                    std::thread::yield_now();
+                }
+            });
+            outer.join().unwrap();
+            inner.join().unwrap();
+        });
+        let last = ROUNDS - 1;
+        assert_eq!(
+            fs::read_to_string(dir.join("a.csv")).unwrap(),
+            format!("outer {last}")
+        );
+        assert_eq!(
+            fs::read_to_string(sub.join("s.csv")).unwrap(),
+            format!("inner {last}")
+        );
+        assert_eq!(
+            tree(root.path()),
+            ["X", "X/a.csv", "X/b.json", "X/sub", "X/sub/s.csv"]
+        );
+    }
+
+    /// A swap gives the folders of the target back themselves, not copies:
+    /// a file kept open in one and written after the swap is there, and the
+    /// folder is the same folder (what is mounted below it, or a shell's
+    /// working folder in it, stays).
+    #[test]
+    fn a_swap_gives_back_the_folders_themselves() {
+        use std::io::Write as _;
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        fs::create_dir_all(dir.join("sub/deeper")).unwrap();
+        let before = fs::metadata(dir.join("sub")).unwrap().ino();
+        let mut open = File::create(dir.join("sub/deeper/log.txt")).unwrap();
+        one_set(&dir, "one").unwrap();
+        open.write_all(b"written after the swap").unwrap();
+        drop(open);
+        assert_eq!(fs::metadata(dir.join("sub")).unwrap().ino(), before);
+        assert_eq!(
+            fs::read_to_string(dir.join("sub/deeper/log.txt")).unwrap(),
+            "written after the swap"
+        );
+        assert_eq!(listing(root.path()), ["X"]);
+    }
+
+    /// What a run killed during its swap left beside the folder — the
+    /// previous folder, holding a folder of the target whose stand-in is in
+    /// the target — is given back by the next set, never removed with it.
+    #[test]
+    fn the_next_set_gives_back_what_a_killed_swap_left() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        fs::create_dir_all(dir.join("sub")).unwrap();
+        let left = root.path().join(".X.staging-1-2-3");
+        fs::create_dir_all(left.join("sub")).unwrap();
+        fs::write(left.join("sub/precious.txt"), "kept").unwrap();
+        fs::write(left.join("a.csv"), "the previous set's").unwrap();
+        one_set(&dir, "next").unwrap();
+        assert_eq!(
+            fs::read_to_string(dir.join("sub/precious.txt")).unwrap(),
+            "kept"
+        );
+        assert_eq!(fs::read_to_string(dir.join("a.csv")).unwrap(), "next");
+        assert_eq!(listing(root.path()), ["X"]);
+    }
+
+    /// Files written beside an output file are renamed into its folder, the
+    /// folder itself never swapped; a second set into the folder meanwhile
+    /// is refused.
+    #[test]
+    fn a_set_beside_a_file_leaves_its_folder_in_place() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("D");
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(dir.join("notes.txt"), "mine").unwrap();
+        let inode = fs::metadata(&dir).unwrap().ino();
+        let set = OutputSet::begin_beside(&dir, &["x.json", "x-path.csv"]).unwrap();
+        assert!(matches!(
+            OutputSet::begin(&dir, &["y.csv"]),
+            Err(ReportError::Busy { .. })
+        ));
+        fs::write(set.path("x.json"), "{}").unwrap();
+        fs::write(set.path("x-path.csv"), "a\n").unwrap();
+        let written = set.commit().unwrap();
+        assert_eq!(
+            written,
+            [
+                dir.canonicalize().unwrap().join("x.json"),
+                dir.canonicalize().unwrap().join("x-path.csv")
+            ]
+        );
+        assert_eq!(fs::metadata(&dir).unwrap().ino(), inode);
+        assert_eq!(listing(&dir), ["notes.txt", "x-path.csv", "x.json"]);
+        assert_eq!(listing(root.path()), ["D"]);
     }
 }
