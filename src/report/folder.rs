@@ -195,6 +195,7 @@ pub(super) fn mount_points_in(
 
 #[cfg(test)]
 mod tests {
+    use super::super::atomic::write_atomic;
     use super::*;
 
     #[test]
@@ -204,7 +205,7 @@ mod tests {
         for sub in ["a", "m", "b/m2"] {
             fs::create_dir_all(dir.join(sub)).unwrap();
         }
-        fs::write(dir.join("m.txt"), "a file").unwrap();
+        write_atomic(&dir.join("m.txt"), b"a file").unwrap();
         // A stand-in for st_dev: `m` (and what is below it) on device 2,
         // everything else on device 1.
         let mounted = dir.join("m");
@@ -212,7 +213,7 @@ mod tests {
             fs::symlink_metadata(p)?;
             Ok(if p.starts_with(&mounted) { 2 } else { 1 })
         };
-        assert_eq!(mount_points_in(&dir, &device).unwrap(), [mounted.clone()]);
+        assert_eq!(mount_points_in(&dir, &device).unwrap(), [mounted.as_path()]);
         assert!(is_mount_point(&mounted, &device).unwrap());
         assert!(!is_mount_point(&dir, &device).unwrap());
         // A mount point deeper down is not one of `dir`'s own entries: it
@@ -227,7 +228,7 @@ mod tests {
         let root = tempfile::tempdir().unwrap();
         check_writable(&root.path().join("a/b/c")).unwrap();
         let file = root.path().join("f");
-        fs::write(&file, "x").unwrap();
+        write_atomic(&file, b"x").unwrap();
         let e = check_writable(&file.join("sub")).unwrap_err();
         assert!(e.to_string().contains("is a file"), "{e}");
         let e = check_writable(&file).unwrap_err();
