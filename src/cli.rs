@@ -71,11 +71,17 @@ pub enum Command {
     /// Writes nodes (equilibrium xyz), lengths, forces, reactions (per fixed node,
     /// in the order of `fixed`) and max_residual.
     ///
+    /// -o names a file or a folder by one rule: an existing folder, or a path
+    /// ending in /, is a folder; otherwise a path ending in .json is the file;
+    /// any other extension is refused; a path without one is a folder
+    /// (created). A folder is never replaced: fdm.json is written into it,
+    /// beside what it holds. The folder is checked writable before computing.
+    ///
     /// Example: ringmesh fdm results/paper-26m/network.json -o equilibrium.json
     Fdm {
         /// The network file (JSON: nodes, edges, fixed, q, loads?, groups?).
         network: PathBuf,
-        /// Output JSON file.
+        /// Output JSON file, or a folder (receives fdm.json).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -194,6 +200,12 @@ pub enum Command {
     /// The other cables only need 0 < q. Writes q, tensions, ratio, max_residual,
     /// solver, termination, iterations, time_s.
     ///
+    /// -o names a file or a folder by one rule: an existing folder, or a path
+    /// ending in /, is a folder; otherwise a path ending in .json is the file;
+    /// any other extension is refused; a path without one is a folder
+    /// (created). A folder is never replaced: uniformity.json is written into it,
+    /// beside what it holds. The folder is checked writable before computing.
+    ///
     /// Example: ringmesh uniformity net.json --solver lp --groups front,boundary -o out.json
     Uniformity {
         /// The network file (interchange JSON).
@@ -212,7 +224,7 @@ pub enum Command {
         /// Upper bound [q] on every force density, N/m [default: none].
         #[arg(long)]
         max_force_density: Option<f64>,
-        /// Output JSON file.
+        /// Output JSON file, or a folder (receives uniformity.json).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -332,12 +344,20 @@ pub enum Command {
     /// Newton iterations, residual history, time) as JSON; prints a summary.
     /// The file format is documented in src/frame/mod.rs.
     ///
+    /// -o names a file or a folder by one rule: an existing folder, or a path
+    /// ending in /, is a folder; otherwise a path ending in .json is the file;
+    /// any other extension is refused; a path without one is a folder
+    /// (created). A folder receives frame.json and frame-path.csv/.png/.svg as
+    /// one set, swapped in whole, keeping the other files it holds. A file
+    /// D/x.json is written with x-path.csv/.png/.svg beside it, each renamed
+    /// into D, which is never swapped. Checked writable before computing.
+    ///
     /// Example: ringmesh frame problems/frames/cantilever-moment.toml
     Frame {
         /// The frame file (TOML).
         file: PathBuf,
-        /// Output JSON file [default: results/<file stem>/frame.json]; the
-        /// path's frame-path.csv/.png/.svg are written beside it.
+        /// Output JSON file, or folder [default: the folder results/<file
+        /// stem>/]; the path's <stem>-path.csv/.png/.svg are written beside it.
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -346,6 +366,12 @@ pub enum Command {
     ///
     /// Loads file: {"loads_n": [[fx, fy, fz], ...]}, top hinges then bottom
     /// hinges, N. Writes truss-<model>.json to results/<scene>/.
+    ///
+    /// -o names a file or a folder by one rule: an existing folder, or a path
+    /// ending in /, is a folder; otherwise a path ending in .json is the file;
+    /// any other extension is refused; a path without one is a folder
+    /// (created). A folder is never replaced: truss-<model>.json is written into it,
+    /// beside what it holds. The folder is checked writable before computing.
     ///
     /// Example: ringmesh truss problems/paper-26m.toml --model linear
     Truss {
@@ -357,12 +383,19 @@ pub enum Command {
         /// Attachment loads (JSON) instead of the net's pull.
         #[arg(long)]
         loads: Option<PathBuf>,
-        /// Output JSON file [default: results/<scene name>/truss-<model>.json].
+        /// Output JSON file, or a folder (receives truss-<model>.json)
+        /// [default: results/<scene name>/].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
     /// The paper's cantilever rolled up by a tip moment (Tables 1–2): analytic,
     /// paper and ours side by side, ML/(πEI) = 0.2 … 2.0 (the full circle).
+    ///
+    /// -o names a file or a folder by one rule: an existing folder, or a path
+    /// ending in /, is a folder; otherwise a path ending in .json is the file;
+    /// any other extension is refused; a path without one is a folder
+    /// (created). A folder is never replaced: cantilever.json is written into it,
+    /// beside what it holds. The folder is checked writable before computing.
     ///
     /// Example: ringmesh cantilever --elements 10 --element crisfield-jelenic
     Cantilever {
@@ -375,7 +408,8 @@ pub enum Command {
         /// Print the table as JSON instead.
         #[arg(long)]
         json: bool,
-        /// Also write the table to this folder, as cantilever.json.
+        /// Also write the table to this folder, as cantilever.json, or to
+        /// this .json file.
         #[arg(short, long)]
         output: Option<PathBuf>,
     },

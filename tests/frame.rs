@@ -285,9 +285,10 @@ fn frame_command_writes_positions_rotations_reactions_and_solver_stats() {
     );
     assert_eq!(points[0]["load_factor"], 0.0);
     assert_eq!(points.last().unwrap()["load_factor"], 1.0);
-    let csv = std::fs::read_to_string(out.with_file_name("frame-path.csv")).unwrap();
+    // Named after the JSON file they are beside (`-o DIR/cantilever.json`).
+    let csv = std::fs::read_to_string(out.with_file_name("cantilever-path.csv")).unwrap();
     assert_eq!(csv.lines().count(), points.len() + 1, "{csv}");
-    for plot in ["frame-path.png", "frame-path.svg"] {
+    for plot in ["cantilever-path.png", "cantilever-path.svg"] {
         assert!(
             out.with_file_name(plot).metadata().unwrap().len() > 0,
             "{plot}"

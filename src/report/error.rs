@@ -43,10 +43,33 @@ pub enum ReportError {
     /// computing.
     #[error("cannot write into the output folder {path}: {source}")]
     Unwritable {
-        /// The folder, or the staging folder beside it.
+        /// The folder given (`-o`), never the staging folder.
         path: PathBuf,
         /// The cause.
         source: std::io::Error,
+    },
+    /// The output folder holds a mount point, which a swap of the folder
+    /// would carry away: found before any computing.
+    #[error(
+        "the output folder {} holds a mount point: {} (a run swaps its folder in whole, \
+         which would carry what is mounted there away); choose another output folder (-o)",
+        path.display(),
+        mounts.iter().map(|m| m.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    MountPoint {
+        /// The folder.
+        path: PathBuf,
+        /// The mount points in it.
+        mounts: Vec<PathBuf>,
+    },
+    /// An `-o` that names neither a file nor a folder the command can write
+    /// ([`OutputPath`](super::OutputPath)).
+    #[error("-o {}: {reason}", path.display())]
+    OutputPath {
+        /// The path given.
+        path: PathBuf,
+        /// Why it cannot be.
+        reason: String,
     },
     /// A file a run's manifest names cannot be read
     /// ([`check_manifest`](super::check_manifest)).
@@ -85,7 +108,11 @@ impl ReportError {
     pub fn is_bad_input(&self) -> bool {
         matches!(
             self,
-            ReportError::Busy { .. } | ReportError::Name { .. } | ReportError::Unwritable { .. }
+            ReportError::Busy { .. }
+                | ReportError::Name { .. }
+                | ReportError::Unwritable { .. }
+                | ReportError::MountPoint { .. }
+                | ReportError::OutputPath { .. }
         )
     }
 }
@@ -94,11 +121,16 @@ impl ReportError {
 pub type DrawError = Box<dyn std::error::Error + Send + Sync>;
 
 /// Where a file staged at `path` goes: `path` itself unless it lies in a
-/// staging folder `.NAME.staging-RUN`, then the same name in `NAME` (what a
-/// message about the file should name).
+/// staging folder — `.NAME.staging-RUN` beside the folder `NAME`, then the
+/// same name in `NAME`; `.staging-RUN` in the folder, then the same name in
+/// that folder — (what a message about the file should name).
 fn shown(path: &Path) -> PathBuf {
     let staged = || {
         let dir = path.parent()?;
+        let name = dir.file_name()?.to_str()?;
+        if name.starts_with(".staging-") {
+            return Some(dir.parent()?.join(path.file_name()?));
+        }
         let (folder, _) = dir
             .file_name()?
             .to_str()?
@@ -120,5 +152,9 @@ mod tests {
             Path::new("/r/small-hex/cables.csv")
         );
         assert_eq!(shown(Path::new("/r/out/a.csv")), Path::new("/r/out/a.csv"));
+        assert_eq!(
+            shown(Path::new("/r/out/.staging-17-5-3/x.json")),
+            Path::new("/r/out/x.json")
+        );
     }
 }

@@ -6,19 +6,22 @@
 mod atomic;
 mod csv;
 mod error;
+mod folder;
 mod number;
+mod output_path;
 mod output_set;
 mod pending;
 mod plot;
 mod vtk;
 
-pub use atomic::{write_atomic, write_json};
+pub use atomic::{json_bytes, write_atomic, write_json};
 pub use csv::{
     aperture_csv, cables_csv, convergence_csv, front_csv, front_row, json_name, parse_front_row,
     parse_study_row, sizing_csv, study_csv, study_row, FrontRow, FRONT_COLUMNS, STUDY_COLUMNS,
 };
 pub use error::{DrawError, ReportError};
 pub use number::{decimal, readable};
+pub use output_path::OutputPath;
 pub use output_set::{check_manifest, FileRecord, OutputSet, RunRecord, WithRun};
 pub use pending::abandon_all_and_exit;
 pub use plot::{

@@ -1,39 +1,71 @@
-//! A command's output files as one set: all of them or none.
+//! A command's output files as one set: all of them or none, and no file
+//! the command did not write ever taken away.
 //!
-//! [`OutputSet::begin`] runs before any computing: it creates the target
-//! folder, takes its lock (a second run into the same folder is refused,
-//! naming it), and creates a staging folder beside it — which proves the
-//! place writable and the names valid. The command writes its files into the
-//! staging folder; [`OutputSet::commit`] then gives the staging folder every
-//! other entry of the target (hard links: the files other commands wrote
-//! there stay) and swaps the two folders with one atomic `renameat2`
-//! `RENAME_EXCHANGE`. A reader, or a run killed at any moment, sees the
-//! previous complete set or the new complete set, never a mix.
+//! [`OutputSet::begin`] runs before any computing: it checks that this user
+//! may write into the target folder as the file system would judge it
+//! (refusing, naming the folder), creates it, refuses a folder that holds a
+//! mount point (a swap would carry what is mounted there away), takes the
+//! locks of `folder.rs` (shared on every folder above the target for the
+//! whole run), refuses a second set into the same folder (naming it),
+//! removes what killed runs left, and creates a staging folder. The command
+//! writes its files into the staging folder; [`OutputSet::commit`] then
+//! publishes them, in one of two ways:
 //!
-//! What is left behind by a run killed with SIGKILL is a staging folder
-//! beside the target (`.NAME.staging-RUN`), never a file in it; the next
-//! run into the same folder removes it. SIGINT and SIGTERM remove it at once
-//! ([`super::abandon_all_and_exit`], which the CLI's signal handler calls), with every
-//! temporary file [`super::write_atomic`] has open (`pending.rs`).
+//! - **Swap** (the run's own folder): the staging folder, beside the target,
+//!   is given every other entry of the target — files as hard links,
+//!   symbolic links recreated, folders as empty stand-ins — and the two are
+//!   exchanged with one atomic `renameat2(RENAME_EXCHANGE)`; each folder the
+//!   target held is then exchanged back into it (the folder itself: its
+//!   inode, what is mounted below it, what a process has open in it stay),
+//!   and whatever a writer that takes no lock put into the old folder
+//!   meanwhile is moved into the new one. The old folder is removed only
+//!   once it is empty (`rmdir`, retried), so nothing is removed with it that
+//!   the run did not write. Every ringmesh writer takes the target's lock,
+//!   so none writes during the swap. A reader, or a run killed at any
+//!   moment, sees the previous complete set or the new one, never a mix.
+//! - **In place** (a target that is a mount point and cannot be renamed, a
+//!   folder owned by another user, which a swap would replace by one this
+//!   user owns, and the files written beside an output file,
+//!   [`OutputSet::begin_beside`]): the staging folder is inside the target
+//!   (`.staging-RUN`) and each file is renamed into the target, JSON last,
+//!   under the target's lock. Each file is whole; a reader at the moment of
+//!   the renames may see files of two runs, which the run's manifest in its
+//!   JSON finds out ([`check_manifest`]).
 //!
-//! The lock is an advisory `flock` on the target folder itself, so it leaves
-//! no file behind; a run that locked a folder which another run has just
-//! swapped away checks the inode and locks the new one.
+//! What a run killed with SIGKILL leaves is its staging folder
+//! (`.NAME.staging-RUN` beside the target, `.staging-RUN` in it), never a
+//! file in the target; the next set into the same folder removes it (giving
+//! back to the target any folder of it the staging folder holds). SIGINT
+//! and SIGTERM remove it at once ([`super::abandon_all_and_exit`], which the
+//! CLI's signal handler calls, and which waits for a set being published),
+//! with every temporary file [`super::write_atomic`] has open (`pending.rs`).
 
+use std::ffi::OsString;
 use std::fs::{self, File};
 use std::io;
+use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 use std::time::{SystemTime, UNIX_EPOCH};
 
-use rustix::fs::FlockOperation;
 use serde::Serialize;
 
 use super::atomic::write_atomic;
 use super::error::ReportError;
+use super::folder::{
+    check_writable, device_of, is_mount_point, lock_ancestors, lock_folder, may_write_into,
+    mount_points_in, Hold, Wait,
+};
 use super::pending::{lock_pending, unregister};
 
 /// Longest file name most file systems take, bytes.
 const NAME_MAX: usize = 255;
+
+/// The name of an in-place staging folder, before the run's identifier.
+const IN_PLACE_PREFIX: &str = ".staging-";
+
+/// How many times the old folder of a swap is emptied of what writers that
+/// take no lock keep adding to it before it is left (and named).
+const EMPTYING_ROUNDS: usize = 1000;
 
 /// A run's JSON report with its [`RunRecord`] first (`"run": {…}`).
 #[derive(Serialize)]
@@ -58,16 +90,27 @@ fn new_run_id() -> String {
     )
 }
 
+/// How a set reaches its target folder (see the module's documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Placement {
+    Swap,
+    InPlace,
+}
+
 /// The files of one run of one command, written into a staging folder and
-/// swapped into the target folder as one.
+/// published into the target folder as one.
 #[derive(Debug)]
 pub struct OutputSet {
     target: PathBuf,
     staging: PathBuf,
     names: Vec<String>,
     run_id: String,
-    /// Holds the target folder's lock while the set lives.
-    _lock: File,
+    placement: Placement,
+    /// Shared locks on every folder above the target, held while the set lives.
+    _above: Vec<File>,
+    /// The staging folder's own lock: the set is alive while it is held (a
+    /// staging folder nobody holds was left by a killed run).
+    _alive: File,
     committed: bool,
     /// Whether this run created the target folder: a refusal after `begin`
     /// then leaves no empty folder behind.
@@ -76,20 +119,49 @@ pub struct OutputSet {
 
 impl OutputSet {
     /// Prepares a set of the files `names` in the folder `dir` (created if
-    /// needed): checks the names, locks the folder, removes what killed runs
-    /// left beside it, and creates the staging folder.
+    /// needed), swapped in as one: checks the names and the permission,
+    /// locks, removes what killed runs left, creates the staging folder.
     ///
     /// # Errors
     /// [`ReportError::Name`] for a name that is not a plain file name,
-    /// [`ReportError::Busy`] when another run holds the folder,
-    /// [`ReportError::Unwritable`] when the folder or the staging folder
-    /// beside it cannot be created.
+    /// [`ReportError::Unwritable`] when the folder, or the folder above it
+    /// where the set is staged, may not be written by this user,
+    /// [`ReportError::MountPoint`] when a folder in it is a mount point,
+    /// [`ReportError::Busy`] when another set is being written into it.
     pub fn begin(dir: &Path, names: &[&str]) -> Result<OutputSet, ReportError> {
+        Self::prepare(dir, names, false)
+    }
+
+    /// Prepares a set of the files `names` written beside other files in the
+    /// folder `dir` (the folder of an output file, `frame -o D/x.json`):
+    /// the folder is never swapped; each file is renamed into it.
+    ///
+    /// # Errors
+    /// As [`OutputSet::begin`], but for mount points, which do not matter here.
+    pub fn begin_beside(dir: &Path, names: &[&str]) -> Result<OutputSet, ReportError> {
+        Self::prepare(dir, names, true)
+    }
+
+    fn prepare(dir: &Path, names: &[&str], beside: bool) -> Result<OutputSet, ReportError> {
         for name in names {
             check_name(name)?;
         }
+        check_writable(dir).map_err(unwritable_at(dir))?;
         let created = fs::symlink_metadata(dir).is_err();
         fs::create_dir_all(dir).map_err(unwritable_at(dir))?;
+        let prepared = Self::prepare_created(dir, names, beside, created);
+        if prepared.is_err() && created {
+            let _ = fs::remove_dir(dir);
+        }
+        prepared
+    }
+
+    fn prepare_created(
+        dir: &Path,
+        names: &[&str],
+        beside: bool,
+        created: bool,
+    ) -> Result<OutputSet, ReportError> {
         let target = fs::canonicalize(dir).map_err(unwritable_at(dir))?;
         let (Some(parent), Some(folder)) = (target.parent(), target.file_name()) else {
             return Err(ReportError::Unwritable {
@@ -100,32 +172,104 @@ impl OutputSet {
                 ),
             });
         };
-        let lock = lock_folder(&target, Wait::No)?;
-        let prefix = format!(".{}.staging-", folder.to_string_lossy());
-        if let Ok(entries) = fs::read_dir(parent) {
+        let above = lock_ancestors(&target).map_err(unwritable_at(&target))?;
+        let lock = lock_folder(&target, Hold::Exclusive, Wait::Yes)
+            .map_err(unwritable_at(&target))?
+            .expect("a waiting lock is always taken");
+        if !may_write_into(&target) {
+            return Err(ReportError::Unwritable {
+                path: target.clone(),
+                source: io::Error::new(
+                    io::ErrorKind::PermissionDenied,
+                    "permission denied (the folder is not writable by this user)",
+                ),
+            });
+        }
+        let metadata = fs::metadata(&target).map_err(unwritable_at(&target))?;
+        // SAFETY: `geteuid` has no preconditions and cannot fail.
+        let owned = metadata.uid() == unsafe { libc::geteuid() };
+        let mount_point = is_mount_point(&target, &device_of).map_err(unwritable_at(&target))?;
+        let placement = if beside || mount_point || !owned {
+            Placement::InPlace
+        } else {
+            Placement::Swap
+        };
+        if placement == Placement::Swap {
+            if !may_write_into(parent) {
+                return Err(ReportError::Unwritable {
+                    path: target.clone(),
+                    source: io::Error::new(
+                        io::ErrorKind::PermissionDenied,
+                        format!(
+                            "permission denied on the folder above it, {}, where the new \
+                             set is made before it is swapped in",
+                            parent.display()
+                        ),
+                    ),
+                });
+            }
+            check_no_mount_points(&target)?;
+        }
+        let beside_prefix = format!(".{}.staging-", folder.to_string_lossy());
+        for (place, prefix) in [
+            (parent, beside_prefix.as_str()),
+            (target.as_path(), IN_PLACE_PREFIX),
+        ] {
+            let Ok(entries) = fs::read_dir(place) else {
+                continue;
+            };
             for entry in entries.flatten() {
-                if entry.file_name().to_string_lossy().starts_with(&prefix) {
-                    let _ = fs::remove_dir_all(entry.path());
+                if !entry.file_name().to_string_lossy().starts_with(prefix) {
+                    continue;
+                }
+                match lock_folder(&entry.path(), Hold::Exclusive, Wait::No) {
+                    Ok(None) => {
+                        return Err(ReportError::Busy {
+                            path: target.clone(),
+                        })
+                    }
+                    Ok(Some(_left)) if place == parent => {
+                        remove_left_staging(&entry.path(), &target)
+                    }
+                    Ok(Some(_left)) => {
+                        let _ = fs::remove_dir_all(entry.path());
+                    }
+                    Err(_) => {}
                 }
             }
         }
         let run_id = new_run_id();
-        let staging = parent.join(format!("{prefix}{run_id}"));
+        let staging = match placement {
+            Placement::Swap => parent.join(format!("{beside_prefix}{run_id}")),
+            Placement::InPlace => target.join(format!("{IN_PLACE_PREFIX}{run_id}")),
+        };
         // Registered and created under the registry's lock, as in
-        // `create_registered`.
-        {
+        // `create_registered`; locked before the target's lock is let go,
+        // so that no other set finds it unlocked.
+        let alive = {
             let mut pending = lock_pending();
             if let Err(e) = fs::create_dir(&staging) {
-                return Err(unwritable_at(&staging)(e));
+                return Err(unwritable_at(&target)(e));
             }
             pending.push(staging.clone());
-        }
+            match lock_folder(&staging, Hold::Exclusive, Wait::No) {
+                Ok(Some(alive)) => alive,
+                Ok(None) | Err(_) => {
+                    let _ = fs::remove_dir(&staging);
+                    pending.retain(|p| p != &staging);
+                    return Err(ReportError::Busy { path: target });
+                }
+            }
+        };
+        drop(lock);
         Ok(OutputSet {
             target,
             staging,
             names: names.iter().map(|n| n.to_string()).collect(),
             run_id,
-            _lock: lock,
+            placement,
+            _above: above,
+            _alive: alive,
             committed: false,
             created,
         })
@@ -144,17 +288,31 @@ impl OutputSet {
         Ok(self.staging.join(name))
     }
 
-    /// Writes the one file `name` into the folder `dir` (created if needed)
-    /// atomically, under the folder's lock: waits while another run holds
-    /// it, so that no set swapped in meanwhile drops the file (the shards
-    /// of one study, run in parallel, each write one).
+    /// Checks, before any computing, that a run may write the folder `dir`
+    /// (see [`OutputSet::write_one`]), as the file system judges it.
     ///
     /// # Errors
-    /// A bad name, a folder that cannot be created, or the write failed.
+    /// [`ReportError::Unwritable`], naming `dir` (and the folder above it
+    /// that refuses, when `dir` does not exist yet).
+    pub fn check_folder(dir: &Path) -> Result<(), ReportError> {
+        check_writable(dir).map_err(unwritable_at(dir))
+    }
+
+    /// Writes the one file `name` into the folder `dir` (created if needed)
+    /// atomically, under the folder's lock: waits while a set is swapped
+    /// into it (or into a folder above it), so that no swap drops the file.
+    /// The folder itself is never swapped.
+    ///
+    /// # Errors
+    /// A bad name, a folder that cannot be created or written, or the write
+    /// failed.
     pub fn write_one(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, ReportError> {
         check_name(name)?;
+        check_writable(dir).map_err(unwritable_at(dir))?;
         fs::create_dir_all(dir).map_err(unwritable_at(dir))?;
-        let _lock = lock_folder(dir, Wait::Yes)?;
+        let target = fs::canonicalize(dir).map_err(unwritable_at(dir))?;
+        let _above = lock_ancestors(&target).map_err(unwritable_at(dir))?;
+        let _lock = lock_folder(&target, Hold::Shared, Wait::Yes).map_err(unwritable_at(dir))?;
         let path = dir.join(name);
         write_atomic(&path, bytes)?;
         Ok(path)
@@ -182,7 +340,6 @@ impl OutputSet {
     pub fn folder(&self) -> &Path {
         &self.target
     }
-
     /// Seals the files written so far: marks each with the run's identifier
     /// where its format has room for a note readers skip (a comment in SVG
     /// and VTU, a `tEXt` chunk in PNG; CSV has none — a comment line breaks
@@ -228,12 +385,14 @@ impl OutputSet {
         })
     }
 
-    /// Swaps the written set into the target folder, keeping every other
+    /// Publishes the written set into the target folder, keeping every other
     /// entry of the folder; returns the set's paths there.
     ///
     /// # Errors
-    /// A file of the set that was not written, or the file system refused
-    /// (the target folder is then as it was).
+    /// A file of the set that was not written, a folder in the target that
+    /// has become a mount point, or the file system refused (the target
+    /// folder is then as it was); after a swap, a folder of the target that
+    /// could not be given back (named, with where it is).
     pub fn commit(mut self) -> Result<Vec<PathBuf>, ReportError> {
         for name in &self.names {
             let path = self.staging.join(name);
@@ -244,33 +403,99 @@ impl OutputSet {
                 });
             }
         }
+        let _lock = lock_folder(&self.target, Hold::Exclusive, Wait::Yes)
+            .map_err(at(&self.target))?
+            .expect("a waiting lock is always taken");
+        match self.placement {
+            Placement::Swap => self.swap()?,
+            Placement::InPlace => self.rename_each()?,
+        }
+        Ok(self.names.iter().map(|n| self.target.join(n)).collect())
+    }
+
+    /// Publishes by swapping the staging folder with the target (under the
+    /// target's lock).
+    fn swap(&mut self) -> Result<(), ReportError> {
+        check_no_mount_points(&self.target)?;
+        let kept = self.give_staging_the_others()?;
+        let permissions = fs::metadata(&self.target)
+            .map_err(at(&self.target))?
+            .permissions();
+        fs::set_permissions(&self.staging, permissions).map_err(at(&self.staging))?;
+        // Held across the swap and the tidying after it: a signal handler
+        // waits for them, and then finds only this run's files to remove.
+        let pending = lock_pending();
+        exchange(&self.staging, &self.target).map_err(at(&self.target))?;
+        self.committed = true;
+        // The staging path now holds the previous folder.
+        let old = self.staging.clone();
+        // A folder that could not be given back leaves the previous folder
+        // as it is, named in the error.
+        let result = give_back(&old, &self.target, &kept)
+            .and_then(|()| empty_old_folder(&old, &self.target, &self.names, &kept));
+        drop(pending);
+        unregister(&self.staging);
+        result
+    }
+
+    /// Gives the staging folder every entry of the target that is not a
+    /// file of the set: files (and other entries that are not folders) as
+    /// hard links (copies where the file system has none), symbolic links
+    /// recreated, folders as empty stand-ins with the same permissions.
+    /// Returns them.
+    fn give_staging_the_others(&self) -> Result<Vec<Kept>, ReportError> {
+        let mut kept = Vec::new();
         for entry in fs::read_dir(&self.target).map_err(at(&self.target))? {
             let entry = entry.map_err(at(&self.target))?;
             let name = entry.file_name();
             if self.names.iter().any(|n| name == n.as_str()) {
                 continue;
             }
-            link_tree(&entry.path(), &self.staging.join(&name))?;
+            let from = entry.path();
+            let to = self.staging.join(&name);
+            let kind = entry.file_type().map_err(at(&from))?;
+            if kind.is_dir() {
+                fs::create_dir(&to).map_err(at(&to))?;
+                if let Ok(m) = fs::metadata(&from) {
+                    let _ = fs::set_permissions(&to, m.permissions());
+                }
+            } else if kind.is_symlink() {
+                let link = fs::read_link(&from).map_err(at(&from))?;
+                std::os::unix::fs::symlink(link, &to).map_err(at(&to))?;
+            } else if fs::hard_link(&from, &to).is_err() {
+                fs::copy(&from, &to).map_err(at(&to))?;
+            }
+            kept.push(Kept {
+                name,
+                folder: kind.is_dir(),
+            });
         }
-        let permissions = fs::metadata(&self.target)
-            .map_err(at(&self.target))?
-            .permissions();
-        fs::set_permissions(&self.staging, permissions).map_err(at(&self.staging))?;
-        // Held across the swap: a signal handler waits for it to finish.
+        Ok(kept)
+    }
+
+    /// Publishes by renaming each file into the target, JSON last (under
+    /// the target's lock), then removes the staging folder.
+    fn rename_each(&mut self) -> Result<(), ReportError> {
+        let mut order: Vec<&String> = self.names.iter().collect();
+        order.sort_by_key(|n| n.ends_with(".json"));
+        // A signal handler waits for the renames: all of them or none.
         let pending = lock_pending();
-        exchange(&self.staging, &self.target).map_err(at(&self.target))?;
+        for name in order {
+            let to = self.target.join(name);
+            fs::rename(self.staging.join(name), &to).map_err(at(&to))?;
+        }
         self.committed = true;
-        drop(pending);
-        // The staging path now holds the previous set.
         let _ = fs::remove_dir_all(&self.staging);
+        drop(pending);
         unregister(&self.staging);
-        Ok(self.names.iter().map(|n| self.target.join(n)).collect())
+        Ok(())
     }
 }
 
 impl Drop for OutputSet {
     fn drop(&mut self) {
         if !self.committed {
+            // It holds this run's files, hard links and empty stand-ins only.
             let _ = fs::remove_dir_all(&self.staging);
             unregister(&self.staging);
             if self.created {
@@ -279,6 +504,160 @@ impl Drop for OutputSet {
             }
         }
     }
+}
+
+/// An entry of the target that the staging folder was given before a swap.
+#[derive(Debug)]
+struct Kept {
+    name: OsString,
+    folder: bool,
+}
+
+/// Refuses a target holding a mount point ([`ReportError::MountPoint`]).
+fn check_no_mount_points(target: &Path) -> Result<(), ReportError> {
+    let mounts = mount_points_in(target, &device_of).map_err(unwritable_at(target))?;
+    if mounts.is_empty() {
+        Ok(())
+    } else {
+        Err(ReportError::MountPoint {
+            path: target.to_path_buf(),
+            mounts,
+        })
+    }
+}
+
+/// After a swap: gives the new folder `new` back each entry `kept` of the
+/// previous one, now in `old`, by exchanging it with its stand-in — the
+/// entry itself, as it is now (replaced, or written into, meanwhile). One
+/// that its writer removed meanwhile loses its stand-in too.
+fn give_back(old: &Path, new: &Path, kept: &[Kept]) -> Result<(), ReportError> {
+    let mut failed = None;
+    for k in kept {
+        let (o, n) = (old.join(&k.name), new.join(&k.name));
+        match fs::symlink_metadata(&o) {
+            Ok(m) => {
+                let same = fs::symlink_metadata(&n)
+                    .is_ok_and(|s| (s.dev(), s.ino()) == (m.dev(), m.ino()));
+                if !same {
+                    if let Err(e) = exchange(&o, &n) {
+                        failed.get_or_insert(ReportError::Io {
+                            path: n,
+                            source: io::Error::new(
+                                e.kind(),
+                                format!("could not be put back ({e}); it is at {}", o.display()),
+                            ),
+                        });
+                    }
+                }
+            }
+            Err(_) if k.folder => {
+                let _ = fs::remove_dir(&n);
+            }
+            Err(_) => {
+                let _ = fs::remove_file(&n);
+            }
+        }
+    }
+    failed.map_or(Ok(()), Err)
+}
+
+/// After a swap: removes from the previous folder `old` the set's previous
+/// files and the stand-ins given back, moves into the new folder `new`
+/// whatever a writer that takes no lock put there meanwhile, and removes
+/// `old` once it is empty — never an entry the run did not write.
+fn empty_old_folder(
+    old: &Path,
+    new: &Path,
+    names: &[String],
+    kept: &[Kept],
+) -> Result<(), ReportError> {
+    for _ in 0..EMPTYING_ROUNDS {
+        let entries = fs::read_dir(old).map_err(at(old))?;
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let path = entry.path();
+            let folder = entry.file_type().is_ok_and(|t| t.is_dir());
+            let ours = !folder && names.iter().any(|n| name == n.as_str());
+            match kept.iter().find(|k| k.name == name) {
+                _ if ours => {
+                    let _ = fs::remove_file(&path);
+                }
+                // The stand-in of a folder: what was written into it
+                // between the swap and the giving back goes to the folder.
+                Some(k) if k.folder && folder => {
+                    move_entries(&path, &new.join(&name));
+                    let _ = fs::remove_dir(&path);
+                }
+                Some(_) if !folder => {
+                    let _ = fs::remove_file(&path);
+                }
+                _ => move_into(&path, &new.join(&name)),
+            }
+        }
+        match fs::remove_dir(old) {
+            Ok(()) => return Ok(()),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+            Err(_) => continue,
+        }
+    }
+    Err(ReportError::Io {
+        path: old.to_path_buf(),
+        source: io::Error::new(
+            io::ErrorKind::DirectoryNotEmpty,
+            "another program keeps writing into the previous folder; it is left as it is",
+        ),
+    })
+}
+
+/// Moves the entry `from` to `to` unless `to` exists: then a folder's
+/// entries are moved into it one by one, and of two files the one at `to`,
+/// written later into the live folder, stays. An entry that cannot be
+/// moved for any other reason stays where it is.
+fn move_into(from: &Path, to: &Path) {
+    match rename_noreplace(from, to) {
+        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
+            let folder = |p: &Path| fs::symlink_metadata(p).is_ok_and(|m| m.is_dir());
+            if folder(from) && folder(to) {
+                move_entries(from, to);
+                let _ = fs::remove_dir(from);
+            } else if !folder(from) {
+                let _ = fs::remove_file(from);
+            }
+        }
+        Ok(()) | Err(_) => {}
+    }
+}
+
+/// Moves every entry of the folder `from` into the folder `to` ([`move_into`]).
+fn move_entries(from: &Path, to: &Path) {
+    if let Ok(entries) = fs::read_dir(from) {
+        for entry in entries.flatten() {
+            move_into(&entry.path(), &to.join(entry.file_name()));
+        }
+    }
+}
+
+/// What a killed run left beside the target `target` (its staging folder,
+/// or the previous folder of a swap it did not finish tidying): each folder
+/// in it that is not an empty stand-in goes back to the target (exchanged
+/// with its stand-in there, or moved), the rest is removed.
+fn remove_left_staging(left: &Path, target: &Path) {
+    if let Ok(entries) = fs::read_dir(left) {
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let to = target.join(entry.file_name());
+            let folder = entry.file_type().is_ok_and(|t| t.is_dir());
+            let empty = |p: &Path| fs::read_dir(p).is_ok_and(|mut d| d.next().is_none());
+            if folder && !empty(&path) {
+                if to.is_dir() && !to.is_symlink() && empty(&to) {
+                    let _ = exchange(&path, &to);
+                } else {
+                    move_into(&path, &to);
+                }
+            }
+        }
+    }
+    let _ = fs::remove_dir_all(left);
 }
 
 /// A run's identifier and the files it wrote (`design.json`'s `run`).
@@ -420,76 +799,37 @@ fn check_name(name: &str) -> Result<(), ReportError> {
     }
 }
 
-/// Whether [`lock_folder`] waits for a run that holds the lock.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Wait {
-    Yes,
-    No,
-}
-
-/// Takes the advisory lock of the folder `target` — waiting for another
-/// run that holds it, or refusing ([`ReportError::Busy`]) — and retries when
-/// the folder was swapped away meanwhile.
-fn lock_folder(target: &Path, wait: Wait) -> Result<File, ReportError> {
-    use std::os::unix::fs::MetadataExt;
-    let io = |e: io::Error| unwritable_at(target)(e);
-    let operation = match wait {
-        Wait::Yes => FlockOperation::LockExclusive,
-        Wait::No => FlockOperation::NonBlockingLockExclusive,
-    };
-    loop {
-        let folder = File::open(target).map_err(io)?;
-        match rustix::fs::flock(&folder, operation) {
-            Ok(()) => {}
-            Err(rustix::io::Errno::WOULDBLOCK) => {
-                return Err(ReportError::Busy {
-                    path: target.to_path_buf(),
-                })
-            }
-            Err(e) => return Err(io(e.into())),
-        }
-        let held = folder.metadata().map_err(io)?;
-        let now = fs::metadata(target).map_err(io)?;
-        if (held.dev(), held.ino()) == (now.dev(), now.ino()) {
-            return Ok(folder);
-        }
-    }
-}
-
-/// Hard-links the file or folder tree `from` to `to` (copies where the file
-/// system has no hard links); symbolic links are recreated.
-fn link_tree(from: &Path, to: &Path) -> Result<(), ReportError> {
-    let kind = fs::symlink_metadata(from).map_err(at(from))?.file_type();
-    if kind.is_symlink() {
-        let link = fs::read_link(from).map_err(at(from))?;
-        std::os::unix::fs::symlink(link, to).map_err(at(to))?;
-    } else if kind.is_dir() {
-        fs::create_dir(to).map_err(at(to))?;
-        for entry in fs::read_dir(from).map_err(at(from))? {
-            let entry = entry.map_err(at(from))?;
-            link_tree(&entry.path(), &to.join(entry.file_name()))?;
-        }
-    } else if fs::hard_link(from, to).is_err() {
-        fs::copy(from, to).map_err(at(to))?;
-    }
-    Ok(())
-}
-
-/// Swaps the folders `a` and `b` in one step.
+/// Swaps the entries `a` and `b` in one step.
 #[cfg(target_os = "linux")]
 fn exchange(a: &Path, b: &Path) -> io::Result<()> {
     use rustix::fs::{renameat_with, RenameFlags, CWD};
     renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE).map_err(io::Error::from)
 }
 
-/// Swaps the folders `a` and `b`: without `RENAME_EXCHANGE`, two renames
-/// (a reader between them finds no folder, never a mix).
+/// Swaps the entries `a` and `b`: without `RENAME_EXCHANGE`, two renames
+/// (a reader between them finds no entry, never a mix).
 #[cfg(not(target_os = "linux"))]
 fn exchange(a: &Path, b: &Path) -> io::Result<()> {
     let aside = a.with_extension("previous");
     fs::rename(b, &aside)?;
     fs::rename(a, b)?;
     fs::rename(&aside, a)
+}
+
+/// Renames `from` to `to`, failing if `to` exists.
+#[cfg(target_os = "linux")]
+fn rename_noreplace(from: &Path, to: &Path) -> io::Result<()> {
+    use rustix::fs::{renameat_with, RenameFlags, CWD};
+    renameat_with(CWD, from, CWD, to, RenameFlags::NOREPLACE).map_err(io::Error::from)
+}
+
+/// Renames `from` to `to`, failing if `to` exists (checked first).
+#[cfg(not(target_os = "linux"))]
+fn rename_noreplace(from: &Path, to: &Path) -> io::Result<()> {
+    if fs::symlink_metadata(to).is_ok() {
+        return Err(io::ErrorKind::AlreadyExists.into());
+    }
+    fs::rename(from, to)
 }
 
 #[cfg(test)]
@@ -597,5 +937,246 @@ mod tests {
             assert!(matches!(e, ReportError::Name { .. }), "{e}");
         }
         assert!(!dir.exists());
+    }
+
+    /// Every entry of `dir` and the folders below it, as relative paths.
+    fn tree(dir: &Path) -> Vec<String> {
+        let mut all = Vec::new();
+        let mut stack = vec![dir.to_path_buf()];
+        while let Some(d) = stack.pop() {
+            for e in fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                all.push(p.strip_prefix(dir).unwrap().to_string_lossy().into_owned());
+                if e.file_type().unwrap().is_dir() {
+                    stack.push(p);
+                }
+            }
+        }
+        all.sort();
+        all
+    }
+
+    /// One set of `a.csv` and `b.json` holding `text`, swapped into `dir`.
+    fn one_set(dir: &Path, text: &str) -> Result<Vec<PathBuf>, ReportError> {
+        let set = OutputSet::begin(dir, &["a.csv", "b.json"])?;
+        fs::write(set.path("a.csv"), text).unwrap();
+        fs::write(set.path("b.json"), text).unwrap();
+        set.commit()
+    }
+
+    /// Issue 40 item 3: while sets are swapped into `X` again and again, a
+    /// program that takes no lock writes plain files into `X` and into a
+    /// folder in it, and ringmesh single-file writers (`fdm -o X/f.json`)
+    /// write theirs: every file either reported written is there afterwards
+    /// with its content, the folder holds the last set, and nothing is
+    /// left beside it or in it (no staging folder, no temporary file).
+    #[test]
+    fn files_written_during_repeated_swaps_are_all_kept() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        fs::create_dir_all(dir.join("sub")).unwrap();
+        one_set(&dir, "first").unwrap();
+        let swaps = AtomicUsize::new(0);
+        // Each writer keeps pace with the swaps (no more than a few writes
+        // ahead of them), so that its writes are spread over all of them.
+        let pace = |per_swap: usize, i: usize| {
+            while swaps.load(Ordering::SeqCst) < i / per_swap {
+                std::thread::yield_now();
+            }
+        };
+        const FOREIGN: usize = 540;
+        const OURS: usize = 100;
+        let (foreign, during, failed, ours) = std::thread::scope(|scope| {
+            let foreign = scope.spawn(|| {
+                let (mut written, mut during, mut failed) = (Vec::new(), 0, Vec::new());
+                for i in 0..FOREIGN {
+                    pace(5, i);
+                    let path = if i % 3 == 0 {
+                        dir.join("sub").join(format!("g-{i}.txt"))
+                    } else {
+                        dir.join(format!("f-{i}.txt"))
+                    };
+                    let before = swaps.load(Ordering::SeqCst);
+                    match fs::write(&path, format!("foreign {i}")) {
+                        Ok(()) => written.push((path, format!("foreign {i}"))),
+                        Err(e) => failed.push(format!("{}: {e}", path.display())),
+                    }
+                    // A swap finished while the file was written.
+                    during += usize::from(swaps.load(Ordering::SeqCst) != before);
+                }
+                (written, during, failed)
+            });
+            let ringmesh = scope.spawn(|| {
+                (0..OURS)
+                    .map(|i| {
+                        pace(1, i);
+                        let name = format!("fdm-{i}.json");
+                        let path = OutputSet::write_one(&dir, &name, name.as_bytes()).unwrap();
+                        (path, name)
+                    })
+                    .collect::<Vec<_>>()
+            });
+            let mut round = 0;
+            while !(foreign.is_finished() && ringmesh.is_finished()) {
+                one_set(&dir, &format!("set {round}")).unwrap();
+                swaps.fetch_add(1, Ordering::SeqCst);
+                round += 1;
+            }
+            let (written, during, failed) = foreign.join().unwrap();
+            (written, during, failed, ringmesh.join().unwrap())
+        });
+        let swaps = swaps.into_inner();
+        let lost: Vec<_> = foreign
+            .iter()
+            .chain(&ours)
+            .filter(|(path, text)| fs::read_to_string(path).ok().as_deref() != Some(text))
+            .map(|(path, _)| path.display().to_string())
+            .collect();
+        eprintln!(
+            "{swaps} swaps; {} foreign writes ({during} met the end of a swap, {} refused to \
+             the writer: {failed:?}), {} ringmesh writes; {} lost",
+            foreign.len(),
+            failed.len(),
+            ours.len(),
+            lost.len()
+        );
+        // A write whose path was looked up in the previous folder and which
+        // creates its file after that folder is gone fails, and its writer
+        // is told (ENOENT); it is not lost.
+        assert!(foreign.len() >= 500, "{failed:?}");
+        assert!(swaps >= FOREIGN / 5, "{swaps} swaps");
+        assert!(lost.is_empty(), "lost: {lost:?}");
+        let last = format!("set {}", swaps - 1);
+        assert_eq!(fs::read_to_string(dir.join("a.csv")).unwrap(), last);
+        assert_eq!(listing(root.path()), ["X"]);
+        let left: Vec<_> = tree(&dir)
+            .into_iter()
+            .filter(|n| n.contains(".staging-") || n.ends_with(".tmp"))
+            .collect();
+        assert!(left.is_empty(), "{left:?}");
+        assert_eq!(tree(&dir).len(), 3 + foreign.len() + OURS);
+    }
+
+    /// Issue 40 item 3: sets swapped into `X` and into `X/sub` at the same
+    /// time (two runs, each again and again) all succeed, and each folder
+    /// holds its last set: the run into `X` never takes `X/sub`'s files,
+    /// nor the other way round; no staging folder is left.
+    #[test]
+    fn sets_into_a_folder_and_a_folder_in_it_never_take_each_others_files() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        let sub = dir.join("sub");
+        const ROUNDS: usize = 40;
+        std::thread::scope(|scope| {
+            let outer = scope.spawn(|| {
+                for i in 0..ROUNDS {
+                    one_set(&dir, &format!("outer {i}")).unwrap();
+                    std::thread::yield_now();
+                }
+            });
+            let inner = scope.spawn(|| {
+                for i in 0..ROUNDS {
+                    let set = OutputSet::begin(&sub, &["s.csv"]).unwrap();
+                    fs::write(set.path("s.csv"), format!("inner {i}")).unwrap();
+                    let written = set.commit().unwrap();
+                    // What the run reports written is there.
+                    assert_eq!(
+                        fs::read_to_string(&written[0]).unwrap(),
+                        format!("inner {i}")
+                    );
+                    std::thread::yield_now();
+                }
+            });
+            outer.join().unwrap();
+            inner.join().unwrap();
+        });
+        let last = ROUNDS - 1;
+        assert_eq!(
+            fs::read_to_string(dir.join("a.csv")).unwrap(),
+            format!("outer {last}")
+        );
+        assert_eq!(
+            fs::read_to_string(sub.join("s.csv")).unwrap(),
+            format!("inner {last}")
+        );
+        assert_eq!(
+            tree(root.path()),
+            ["X", "X/a.csv", "X/b.json", "X/sub", "X/sub/s.csv"]
+        );
+    }
+
+    /// A swap gives the folders of the target back themselves, not copies:
+    /// a file kept open in one and written after the swap is there, and the
+    /// folder is the same folder (what is mounted below it, or a shell's
+    /// working folder in it, stays).
+    #[test]
+    fn a_swap_gives_back_the_folders_themselves() {
+        use std::io::Write as _;
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        fs::create_dir_all(dir.join("sub/deeper")).unwrap();
+        let before = fs::metadata(dir.join("sub")).unwrap().ino();
+        let mut open = File::create(dir.join("sub/deeper/log.txt")).unwrap();
+        one_set(&dir, "one").unwrap();
+        open.write_all(b"written after the swap").unwrap();
+        drop(open);
+        assert_eq!(fs::metadata(dir.join("sub")).unwrap().ino(), before);
+        assert_eq!(
+            fs::read_to_string(dir.join("sub/deeper/log.txt")).unwrap(),
+            "written after the swap"
+        );
+        assert_eq!(listing(root.path()), ["X"]);
+    }
+
+    /// What a run killed during its swap left beside the folder — the
+    /// previous folder, holding a folder of the target whose stand-in is in
+    /// the target — is given back by the next set, never removed with it.
+    #[test]
+    fn the_next_set_gives_back_what_a_killed_swap_left() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("X");
+        fs::create_dir_all(dir.join("sub")).unwrap();
+        let left = root.path().join(".X.staging-1-2-3");
+        fs::create_dir_all(left.join("sub")).unwrap();
+        fs::write(left.join("sub/precious.txt"), "kept").unwrap();
+        fs::write(left.join("a.csv"), "the previous set's").unwrap();
+        one_set(&dir, "next").unwrap();
+        assert_eq!(
+            fs::read_to_string(dir.join("sub/precious.txt")).unwrap(),
+            "kept"
+        );
+        assert_eq!(fs::read_to_string(dir.join("a.csv")).unwrap(), "next");
+        assert_eq!(listing(root.path()), ["X"]);
+    }
+
+    /// Files written beside an output file are renamed into its folder, the
+    /// folder itself never swapped; a second set into the folder meanwhile
+    /// is refused.
+    #[test]
+    fn a_set_beside_a_file_leaves_its_folder_in_place() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("D");
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(dir.join("notes.txt"), "mine").unwrap();
+        let inode = fs::metadata(&dir).unwrap().ino();
+        let set = OutputSet::begin_beside(&dir, &["x.json", "x-path.csv"]).unwrap();
+        assert!(matches!(
+            OutputSet::begin(&dir, &["y.csv"]),
+            Err(ReportError::Busy { .. })
+        ));
+        fs::write(set.path("x.json"), "{}").unwrap();
+        fs::write(set.path("x-path.csv"), "a\n").unwrap();
+        let written = set.commit().unwrap();
+        assert_eq!(
+            written,
+            [
+                dir.canonicalize().unwrap().join("x.json"),
+                dir.canonicalize().unwrap().join("x-path.csv")
+            ]
+        );
+        assert_eq!(fs::metadata(&dir).unwrap().ino(), inode);
+        assert_eq!(listing(&dir), ["notes.txt", "x-path.csv", "x.json"]);
+        assert_eq!(listing(root.path()), ["D"]);
     }
 }

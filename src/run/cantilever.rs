@@ -9,7 +9,7 @@ use super::Summary;
 use crate::frame::cantilever::{self, CantileverRow};
 use crate::frame::FrameFileError;
 use crate::mechanics::ElementKind;
-use crate::report::OutputSet;
+use crate::report::{json_bytes, OutputPath, OutputSet};
 use crate::Error;
 
 /// One row of `ringmesh cantilever`: the engine's row and the paper's result
@@ -118,15 +118,23 @@ impl CantileverTable {
 
 /// `ringmesh cantilever`: the paper's Tables 1–2 (§3.4) with `elements`
 /// elements of `kind`, every load from 0.2 to the full circle; with
-/// `output_dir`, also written there as `cantilever.json`.
+/// `output`, also written there: a folder receives `cantilever.json`, a
+/// path ending in `.json` is the file ([`OutputPath`]); its folder is
+/// checked before computing.
 ///
 /// # Errors
 /// The engine's, and the writer's.
 pub fn cantilever(
     elements: usize,
     kind: ElementKind,
-    output_dir: Option<&Path>,
+    output: Option<&Path>,
 ) -> Result<CantileverTable, Error> {
+    let target = output
+        .map(|o| OutputPath::resolve(o).map(|t| t.folder_and_name("cantilever.json")))
+        .transpose()?;
+    if let Some((dir, _)) = &target {
+        OutputSet::check_folder(dir)?;
+    }
     let rows = cantilever::table(elements, kind)
         .map_err(FrameFileError::from)?
         .into_iter()
@@ -144,10 +152,9 @@ pub fn cantilever(
         element: kind.name().to_string(),
         rows,
     };
-    if let Some(dir) = output_dir {
-        let mut bytes = serde_json::to_vec_pretty(&table).expect("a table serialises");
-        bytes.push(b'\n');
-        OutputSet::write_one(dir, "cantilever.json", &bytes)?;
+    if let Some((dir, name)) = target {
+        let bytes = json_bytes(&dir.join(&name), &table)?;
+        OutputSet::write_one(&dir, &name, &bytes)?;
     }
     Ok(table)
 }

@@ -7,7 +7,7 @@ use serde::Serialize;
 use super::Summary;
 use crate::fdm::solve_network;
 use crate::network::Network;
-use crate::report::write_json;
+use crate::report::{json_bytes, OutputPath, OutputSet};
 use crate::Error;
 
 /// The output of `ringmesh fdm`.
@@ -45,8 +45,11 @@ impl FdmOutcome {
 }
 
 /// `ringmesh fdm`: forward equilibrium of an interchange-format network,
-/// written to `output_path`.
+/// written to `output_path` (a `.json` file, or a folder that receives
+/// `fdm.json`: [`OutputPath`]), whose folder is checked before computing.
 pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutcome, Error> {
+    let (dir, name) = OutputPath::resolve(output_path)?.folder_and_name("fdm.json");
+    OutputSet::check_folder(&dir)?;
     let network = Network::read_json(network_path)?;
     let (_, equilibrium) = solve_network(&network)?;
     let output = FdmOutput {
@@ -56,9 +59,7 @@ pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutcome, Error>
         forces: equilibrium.edges_forces_n,
         reactions: equilibrium.reactions_n,
     };
-    write_json(output_path, &output)?;
-    Ok(FdmOutcome {
-        output,
-        written: output_path.to_path_buf(),
-    })
+    let bytes = json_bytes(&dir.join(&name), &output)?;
+    let written = OutputSet::write_one(&dir, &name, &bytes)?;
+    Ok(FdmOutcome { output, written })
 }

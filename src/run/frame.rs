@@ -12,14 +12,18 @@ use crate::mechanics::{
     rotation, CriticalPoint, MechanicsError, PathPoint, StaticSolver, StaticTermination, StepRecord,
 };
 use crate::report::{
-    json_name, path_plot, readable, write_atomic, write_json, OutputSet, PathFigure,
+    json_name, path_plot, readable, write_atomic, write_json, OutputPath, OutputSet, PathFigure,
 };
 use crate::Error;
 
-/// The path files written beside the frame's JSON.
-const PATH_CSV: &str = "frame-path.csv";
-const PATH_PNG: &str = "frame-path.png";
-const PATH_SVG: &str = "frame-path.svg";
+/// The path files written beside the frame's JSON `json_name`, named after
+/// it (`frame.json` → `frame-path.csv`, `.png`, `.svg`).
+fn path_file_names(json_name: &str) -> [String; 3] {
+    let stem = Path::new(json_name)
+        .file_stem()
+        .map_or_else(|| "frame".into(), |s| s.to_string_lossy().into_owned());
+    ["csv", "png", "svg"].map(|e| format!("{stem}-path.{e}"))
+}
 
 /// The followed path in `ringmesh frame`'s output.
 #[derive(Debug, Clone, Serialize)]
@@ -237,24 +241,27 @@ fn frame_summary(o: &FrameOutput) -> String {
 /// `ringmesh frame`: reads a frame file, follows its equilibrium path to
 /// the target (`[path]`, by default the full load) and writes every node's
 /// position, displacement and rotation, the reactions, the solver's
-/// statistics and the path with its critical points as JSON
-/// (`output_path`, default [`default_frame_output`]), and beside it the path
-/// as `frame-path.csv` and `frame-path.png/.svg` (load factor against the
-/// first recorded node's displacement), all or none. Not reaching the target
-/// is a termination status in the output, not an error. Returns the output
-/// and the files written.
+/// statistics and the path with its critical points as JSON, and beside it
+/// the path as `<stem>-path.csv` and `<stem>-path.png/.svg` (load factor
+/// against the first recorded node's displacement), all or none. Where:
+/// `output_path` by [`OutputPath`]'s rule — a folder (by default that of
+/// [`default_frame_output`]) receives `frame.json` and `frame-path.*` as one
+/// set swapped in; a `.json` file is written with its path files beside it,
+/// each renamed into its folder, which is never swapped. Not reaching the
+/// target is a termination status in the output, not an error. Returns the
+/// output and the files written.
 pub fn frame(frame_path: &Path, output_path: Option<&Path>) -> Result<FrameOutcome, Error> {
+    let target = match output_path {
+        Some(p) => OutputPath::resolve(p)?,
+        None => OutputPath::Folder(
+            default_frame_output(frame_path)
+                .parent()
+                .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+        ),
+    };
+    let (dir, json_name) = target.folder_and_name("frame.json");
+    let [path_csv_name, path_png, path_svg] = path_file_names(&json_name);
     let file = FrameFile::read(frame_path)?;
-    let output_path =
-        output_path.map_or_else(|| default_frame_output(frame_path), Path::to_path_buf);
-    let dir = output_path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let json_name = output_path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "frame.json".into());
     let counts = FrameCounts {
         nodes: file.model.node_count(),
         rods: file.model.rods().len(),
@@ -267,7 +274,11 @@ pub fn frame(frame_path: &Path, output_path: Option<&Path>) -> Result<FrameOutco
         "the factorised stiffness",
         crate::resources::frame_memory(counts.elements as u64),
     )?;
-    let set = OutputSet::begin(dir, &[json_name.as_str(), PATH_CSV, PATH_PNG, PATH_SVG])?;
+    let names = [json_name.as_str(), &path_csv_name, &path_png, &path_svg];
+    let set = match target {
+        OutputPath::Folder(_) => OutputSet::begin(&dir, &names)?,
+        OutputPath::File { .. } => OutputSet::begin_beside(&dir, &names)?,
+    };
     let solver = StaticSolver::new(file.model.clone()).map_err(FrameFileError::from)?;
     let followed = solver
         .follow_path(&file.path, &file.settings)
@@ -364,11 +375,11 @@ pub fn frame(frame_path: &Path, output_path: Option<&Path>) -> Result<FrameOutco
         })
         .into());
     }
-    write_atomic(&set.path(PATH_CSV), path_csv(&output).as_bytes())?;
+    write_atomic(&set.path(&path_csv_name), path_csv(&output).as_bytes())?;
     path_plot(
         &path_figure(&output),
-        &set.path(PATH_PNG),
-        &set.path(PATH_SVG),
+        &set.path(&path_png),
+        &set.path(&path_svg),
     )?;
     write_json(&set.path(&json_name), &output)?;
     Ok(FrameOutcome {

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::{default_output_dir, read_scene, Summary};
-use crate::report::write_json;
+use crate::report::{json_bytes, OutputPath, OutputSet};
 use crate::scene::TrussModel;
 use crate::truss::SceneTrussResponse;
 use crate::Error;
@@ -49,7 +49,9 @@ impl TrussOutcome {
 /// `ringmesh truss`: the scene's truss model (default: the scene's
 /// `[effects] truss`) under the pull of its net (forward FDM with the initial
 /// q) or under the loads of a file; writes `truss-<model>.json` beside the
-/// scene's other results.
+/// scene's other results, or to `output_path` (a `.json` file, or a folder
+/// that receives `truss-<model>.json`: [`OutputPath`]), whose folder is
+/// checked before computing.
 pub fn truss(
     scene_path: &Path,
     model: Option<TrussModel>,
@@ -57,19 +59,19 @@ pub fn truss(
     output_path: Option<&Path>,
 ) -> Result<TrussOutcome, Error> {
     let scene = read_scene(scene_path)?;
+    let target = match output_path {
+        Some(p) => OutputPath::resolve(p)?,
+        None => OutputPath::Folder(default_output_dir(&scene)),
+    };
+    OutputSet::check_folder(&target.folder_and_name("").0)?;
     let model = model.unwrap_or(scene.effects.truss);
     let loads = match loads_path {
         Some(p) => Some((p.display().to_string(), crate::truss::read_loads(p)?)),
         None => None,
     };
     let response = crate::truss::respond(&scene, model, loads)?;
-    let path = output_path.map_or_else(
-        || default_output_dir(&scene).join(format!("truss-{}.json", response.model)),
-        Path::to_path_buf,
-    );
-    write_json(&path, &response)?;
-    Ok(TrussOutcome {
-        response,
-        written: path,
-    })
+    let (dir, name) = target.folder_and_name(&format!("truss-{}.json", response.model));
+    let bytes = json_bytes(&dir.join(&name), &response)?;
+    let written = OutputSet::write_one(&dir, &name, &bytes)?;
+    Ok(TrussOutcome { response, written })
 }

@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::Summary;
 use crate::algebra::norm3;
 use crate::network::Network;
-use crate::report::{json_name, write_json};
+use crate::report::{json_bytes, json_name, OutputPath, OutputSet};
 use crate::uniformity::{
     Route, SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem,
     UniformitySet,
@@ -84,6 +84,9 @@ impl UniformityOutcome {
 /// `mean_tension_n`: its target (default: the mean tension of the file's `q`);
 /// `max_force_density_n_per_m`: the bound `[q]` on every cable (may be infinite);
 /// `solver` defaults to [`SolverKind::default_for`] one unloaded set (`lp`).
+/// `output_path`: a `.json` file, or a folder that receives
+/// `uniformity.json` ([`OutputPath`]), whose folder is checked before
+/// computing.
 pub fn uniformity(
     network_path: &Path,
     solver: Option<SolverKind>,
@@ -92,6 +95,8 @@ pub fn uniformity(
     max_force_density_n_per_m: f64,
     output_path: &Path,
 ) -> Result<UniformityOutcome, Error> {
+    let (dir, file_name) = OutputPath::resolve(output_path)?.folder_and_name("uniformity.json");
+    OutputSet::check_folder(&dir)?;
     let network = Network::read_json(network_path)?;
     let output = uniformity_of(
         network,
@@ -101,11 +106,9 @@ pub fn uniformity(
         mean_tension_n,
         max_force_density_n_per_m,
     )?;
-    write_json(output_path, &output)?;
-    Ok(UniformityOutcome {
-        output,
-        written: output_path.to_path_buf(),
-    })
+    let bytes = json_bytes(&dir.join(&file_name), &output)?;
+    let written = OutputSet::write_one(&dir, &file_name, &bytes)?;
+    Ok(UniformityOutcome { output, written })
 }
 
 /// The work of [`uniformity`] on a network in memory (validated here), the
