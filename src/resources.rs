@@ -104,24 +104,83 @@ pub fn scene_nodes(scene: &Scene) -> u64 {
 /// Memory of one command's workload on `scene`, bytes (see the module
 /// documentation).
 pub fn scene_memory(scene: &Scene, command: SceneCommand) -> u64 {
-    let nodes = scene_nodes(scene);
+    net_memory(scene_nodes(scene), command)
+}
+
+/// Memory of one command's workload on a net of `nodes` nodes, bytes: the
+/// one estimate behind [`scene_memory`] and [`network_memory`] (see the
+/// module documentation).
+pub fn net_memory(nodes: u64, command: SceneCommand) -> u64 {
     let (base, per_node) = match command {
         SceneCommand::Mesh => (16 << 20, 1_200),
-        SceneCommand::Optimize => (32 << 20, 3_600),
+        SceneCommand::Optimize | SceneCommand::Truss => (32 << 20, 3_600),
         SceneCommand::Design => (100 << 20, 21_000),
     };
     base + nodes.saturating_mul(per_node)
 }
 
+/// Memory of one command's workload on an interchange-format network of
+/// `nodes` nodes and `edges` cables, bytes: [`net_memory`] of the nodes,
+/// or of a third of the cables when they are more (a reflector net has
+/// about three cables a node; a denser graph costs as its cables do).
+pub fn network_memory(nodes: u64, edges: u64, command: SceneCommand) -> u64 {
+    net_memory(nodes.max(edges / 3), command)
+}
+
 /// The workloads [`scene_memory`] estimates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SceneCommand {
-    /// Building and writing the network.
+    /// Building and writing the network (`mesh`; `fdm`'s one solve).
     Mesh,
-    /// One uniformity solve.
+    /// One uniformity solve (`optimize`, `uniformity`).
     Optimize,
+    /// The net built and solved once for its pull on the truss (`truss`):
+    /// as [`SceneCommand::Optimize`], the truss's few elements aside.
+    Truss,
     /// The outer loop, its verification and limit search.
     Design,
+}
+
+/// Checks `command`'s workload on an interchange-format network read from
+/// `path` ([`network_memory`]), naming the file and its size.
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_network(
+    path: &std::path::Path,
+    nodes: usize,
+    edges: usize,
+    command: SceneCommand,
+) -> Result<(), MemoryError> {
+    check_memory(
+        &path.display().to_string(),
+        &format!("{nodes} nodes, {edges} cables"),
+        network_memory(nodes as u64, edges as u64, command),
+    )
+}
+
+/// Checks `command`'s workload on `scene` with the refusal naming `key`
+/// before the net (an aperture of a sweep, say: `--apertures 1000`).
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_scene_for(scene: &Scene, command: SceneCommand, key: &str) -> Result<(), MemoryError> {
+    check_scene_as(scene, command, 1, None).map_err(|mut e| {
+        e.key = format!("{key}: {}", e.key);
+        e
+    })
+}
+
+/// Checks a frame of `elements` elements ([`frame_memory`]), naming `key`.
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_frame(key: &str, elements: usize) -> Result<(), MemoryError> {
+    check_memory(
+        key,
+        &format!("{elements} elements"),
+        frame_memory(elements as u64),
+    )
 }
 
 /// Checks `command`'s workload on `scene`, naming `front_net.rings`;

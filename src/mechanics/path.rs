@@ -82,6 +82,21 @@ impl StaticSolver {
                 "leaving a bifurcation for its branch needs path = \"arc_length\"".into(),
             );
         }
+        if spec.control.is_some() && settings.path != PathControl::Displacement {
+            // The controlled translation drives displacement control only:
+            // under another control it would be ignored.
+            return bad(
+                "path.control",
+                format!(
+                    "drives displacement control only, and the solver's path is {}: remove \
+                     it, or set path = \"displacement\"",
+                    match settings.path {
+                        PathControl::Load => "\"load\"",
+                        _ => "\"arc_length\"",
+                    }
+                ),
+            );
+        }
         if let PathTarget::Steps(0) = spec.target {
             return bad("path.target", "must be at least one step".into());
         }

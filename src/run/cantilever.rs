@@ -127,6 +127,7 @@ pub fn cantilever(
     kind: ElementKind,
     output_dir: Option<&Path>,
 ) -> Result<CantileverTable, Error> {
+    crate::resources::check_frame(&format!("--elements {elements}"), elements)?;
     let rows = cantilever::table(elements, kind)
         .map_err(FrameFileError::from)?
         .into_iter()

@@ -8,6 +8,7 @@ use super::Summary;
 use crate::fdm::solve_network;
 use crate::network::Network;
 use crate::report::write_json;
+use crate::resources::{check_network, SceneCommand};
 use crate::Error;
 
 /// The output of `ringmesh fdm`.
@@ -48,6 +49,12 @@ impl FdmOutcome {
 /// written to `output_path`.
 pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutcome, Error> {
     let network = Network::read_json(network_path)?;
+    check_network(
+        network_path,
+        network.n_nodes(),
+        network.edges.len(),
+        SceneCommand::Mesh,
+    )?;
     let (_, equilibrium) = solve_network(&network)?;
     let output = FdmOutput {
         max_residual: equilibrium.max_residual_n(),

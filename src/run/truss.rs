@@ -58,6 +58,7 @@ pub fn truss(
 ) -> Result<TrussOutcome, Error> {
     let scene = read_scene(scene_path)?;
     let model = model.unwrap_or(scene.effects.truss);
+    crate::resources::check_scene(&scene, crate::resources::SceneCommand::Truss, 1)?;
     let loads = match loads_path {
         Some(p) => Some((p.display().to_string(), crate::truss::read_loads(p)?)),
         None => None,

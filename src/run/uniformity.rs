@@ -93,6 +93,12 @@ pub fn uniformity(
     output_path: &Path,
 ) -> Result<UniformityOutcome, Error> {
     let network = Network::read_json(network_path)?;
+    crate::resources::check_network(
+        network_path,
+        network.n_nodes(),
+        network.edges.len(),
+        crate::resources::SceneCommand::Optimize,
+    )?;
     let default_groups = vec!["front".to_string()];
     let groups: Vec<String> = match (groups, &network.groups) {
         (Some(g), _) => g.to_vec(),
