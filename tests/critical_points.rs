@@ -148,7 +148,11 @@ fn below_the_bifurcation_load_control_is_a_plain_success() {
     let p_cr = arc_length_critical_force();
     let path = follow(&argyris(-0.9 * p_cr, "load", 1.0));
     assert_eq!(path.solution.termination, StaticTermination::Converged);
-    assert!(path.critical_points.is_empty(), "{:?}", path.critical_points);
+    assert!(
+        path.critical_points.is_empty(),
+        "{:?}",
+        path.critical_points
+    );
     assert_eq!(path.final_negative_eigenvalues, Some(0));
 }
 
@@ -163,7 +167,12 @@ fn arc_length_far_past_the_buckling_reports_exactly_one_bifurcation() {
     // One negative eigenvalue from the bifurcation to the end, none before.
     for p in &path.points {
         let expected = usize::from(p.load_factor > found[0]);
-        assert_eq!(p.negative_eigenvalues, Some(expected), "λ = {}", p.load_factor);
+        assert_eq!(
+            p.negative_eigenvalues,
+            Some(expected),
+            "λ = {}",
+            p.load_factor
+        );
     }
 }
 
@@ -177,8 +186,11 @@ fn an_exit_3_names_the_target_not_reached() {
         "target = { on = { node = \"tip\" }, component = \"x\", displacement_m = -50.0 }",
     );
     let file = dir.path().join("argyris.toml");
-    std::fs::write(&file, text.replace("max_step = 0.05", "max_step = 0.05\nmax_steps = 3"))
-        .unwrap();
+    std::fs::write(
+        &file,
+        text.replace("max_step = 0.05", "max_step = 0.05\nmax_steps = 3"),
+    )
+    .unwrap();
     let out = dir.path().join("frame.json");
     let run = common::ringmesh(&["frame", file.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&run.stderr);

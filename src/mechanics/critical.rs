@@ -230,7 +230,10 @@ pub(super) fn between(
             // The crossing eigenvalue: the least in magnitude, positive
             // while the inertia is the start's.
             let size = |e: Option<f64>| e.map_or(1.0, f64::abs);
-            let (f0, f1) = (size(from.indicators.eigenvalue), -size(to.indicators.eigenvalue));
+            let (f0, f1) = (
+                size(from.indicators.eigenvalue),
+                -size(to.indicators.eigenvalue),
+            );
             let crossing = |s: &Corrected| {
                 let n = negative_eigenvalues(solver, &s.state, s.lambda)?;
                 let least = lowest_eigenpair(solver, &s.state, s.lambda).ok()?;

@@ -330,11 +330,13 @@ impl StaticSolver {
             settings,
             &mut |state, lambda, iterations| {
                 if !settings.stability {
-                    run.points.push(follower.point_at(state, lambda, iterations));
+                    run.points
+                        .push(follower.point_at(state, lambda, iterations));
                     return;
                 }
                 let Some(node) = node_at(state, lambda) else {
-                    run.points.push(follower.point_at(state, lambda, iterations));
+                    run.points
+                        .push(follower.point_at(state, lambda, iterations));
                     last = None;
                     final_negative = None;
                     return;

@@ -247,3 +247,77 @@ pub(super) fn translations(solver: &StaticSolver, z: &[f64]) -> Mode {
     }
     Mode(t)
 }
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{DMatrix, Vector3};
+
+    use super::*;
+    use crate::mechanics::{ElementKind, JointKind, ModelBuilder, RodSpec, Section};
+    use crate::mechanics::{StaticSettings, StaticTermination};
+
+    /// A clamped-free column of length 1 m along x in two rods joined by a
+    /// fixed joint (so that the tangent has multipliers), bending
+    /// stiffnesses 1 and 2 N·m², under an axial tip force `p` (N).
+    fn column(p: f64) -> StaticSolver {
+        let spec = RodSpec {
+            section: Section {
+                axial_n: 1e4,
+                shear_n: [1e4, 1e4],
+                torsion_nm2: 1.0,
+                bending_nm2: [1.0, 2.0],
+            },
+            elements: 4,
+            kind: ElementKind::Se3,
+        };
+        let mut b = ModelBuilder::new();
+        let mid = Vector3::new(0.5, 0.0, 0.0);
+        let first = b.add_rod(Vector3::zeros(), mid, Vector3::z(), &spec);
+        let second = b.add_rod(mid, Vector3::x(), Vector3::z(), &spec);
+        b.add_joint(JointKind::Fixed, first.end(), second.start(), mid);
+        b.fix(first.start(), [true; 6]);
+        b.add_load(second.end(), Vector3::new(-p, 0.0, 0.0), Vector3::zeros());
+        StaticSolver::new(b.build().unwrap()).unwrap()
+    }
+
+    /// The negative eigenvalues of the stiffness on `ker A`, counted
+    /// independently of the factorisation: `ker A` from the eigenvectors
+    /// of `AᵀA` with zero eigenvalue, then the eigenvalues of `ZᵀHZ`.
+    fn negative_by_eigenvalues(solver: &StaticSolver, state: &State, lambda: f64) -> usize {
+        let system = solver.system();
+        let ev = system.evaluate(solver.model(), state, lambda);
+        let j = system.dense_tangent(&ev.values);
+        let (n, m) = (system.n_free, system.n_rows - system.n_free);
+        let h = DMatrix::from_fn(n, n, |r, c| 0.5 * (j[(r, c)] + j[(c, r)]));
+        let a = DMatrix::from_fn(m, n, |r, c| j[(n + r, c)]);
+        let ata = (a.transpose() * &a).symmetric_eigen();
+        let top = ata.eigenvalues.amax();
+        let kernel: Vec<usize> = (0..n)
+            .filter(|&i| ata.eigenvalues[i] <= 1e-10 * top)
+            .collect();
+        assert_eq!(kernel.len(), n - m, "A has full rank");
+        let z = DMatrix::from_fn(n, kernel.len(), |r, c| ata.eigenvectors[(r, kernel[c])]);
+        let reduced = (z.transpose() * h * &z).symmetric_eigen();
+        let scale = reduced.eigenvalues.amax();
+        reduced
+            .eigenvalues
+            .iter()
+            .filter(|&&e| e < -1e-10 * scale)
+            .count()
+    }
+
+    #[test]
+    fn the_inertia_counts_the_negative_eigenvalues_on_the_constraints() {
+        // Euler's clamped-free loads π²EI/(4L²): 2.467 N and 4.935 N.
+        let first = std::f64::consts::PI.powi(2) / 4.0;
+        for (p, expected) in [(0.5 * first, 0), (1.5 * first, 1), (3.0 * first, 2)] {
+            let solver = column(p);
+            let solution = solver.solve(&StaticSettings::default()).unwrap();
+            assert_eq!(solution.termination, StaticTermination::Converged, "{p}");
+            let counted = negative_eigenvalues(&solver, &solution.state, 1.0);
+            let independent = negative_by_eigenvalues(&solver, &solution.state, 1.0);
+            assert_eq!(independent, expected, "P = {p} N");
+            assert_eq!(counted, Some(expected), "P = {p} N");
+        }
+    }
+}
