@@ -185,11 +185,20 @@ fn inverse_iteration(
 /// 1 000 rows, tens of ms), beside the sparse LU of the solves.
 pub(super) const INERTIA_ROWS: usize = 1_000;
 
+/// An equilibrium's tangent counts as symmetric when no entry differs from
+/// its transpose's by more than this fraction of the largest entry: under
+/// conservative loads it is, to the residual's roundoff; a moment fixed in
+/// space (not conservative under finite rotations) makes it unsymmetric by
+/// the moment's size.
+const SYMMETRY: f64 = 1e-8;
+
 /// The number of negative eigenvalues of the stiffness on the joints'
 /// constraints at `state` (module doc): the negative pivots of the
-/// Bunch–Kaufman `LBLᵀ` of the tangent's symmetric part, less one per
-/// multiplier. `None` for a tangent of more than [`INERTIA_ROWS`] rows or
-/// with entries that are not finite.
+/// Bunch–Kaufman `LBLᵀ` of the tangent, less one per multiplier. `None`
+/// for a tangent of more than [`INERTIA_ROWS`] rows, with entries that are
+/// not finite, or unsymmetric ([`SYMMETRY`]: loads that are not
+/// conservative have no energy whose second variation the inertia would
+/// count).
 pub(super) fn negative_eigenvalues(
     solver: &StaticSolver,
     state: &State,
@@ -205,6 +214,17 @@ pub(super) fn negative_eigenvalues(
     }
     let j = system.dense_tangent(&ev.values);
     let n = system.n_rows;
+    let mut largest: f64 = 0.0;
+    let mut asymmetry: f64 = 0.0;
+    for c in 0..n {
+        for r in 0..n {
+            largest = largest.max(j[(r, c)].abs());
+            asymmetry = asymmetry.max((j[(r, c)] - j[(c, r)]).abs());
+        }
+    }
+    if asymmetry > SYMMETRY * largest {
+        return None;
+    }
     let symmetric = Mat::from_fn(n, n, |r, c| 0.5 * (j[(r, c)] + j[(c, r)]));
     let lblt = symmetric.lblt(faer::Side::Lower);
     let (diag, sub) = (lblt.B_diag(), lblt.B_subdiag());
