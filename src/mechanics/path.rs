@@ -18,9 +18,11 @@
 //!   the load factor's change per step at most `max_step`; a step that
 //!   fails is cut ÷4 down to `min_step`.
 //! * Critical points ([`super::critical`]): a sign change of the load's
-//!   derivative along the path is a limit point, one of the lowest
-//!   eigenvalue without it a bifurcation; each is located between its two
-//!   steps by re-solving the step to a fraction of its length.
+//!   derivative along the path is a limit point, a change of the tangent's
+//!   inertia without it a bifurcation (under load control too); each is
+//!   located between its two steps by re-solving the step to a fraction of
+//!   its length. The last point's inertia says whether the path ended on
+//!   an unstable branch.
 
 use std::time::Instant;
 

@@ -263,7 +263,7 @@ fn frame_summary(o: &FrameOutput) -> String {
 /// The frame file's path target, in words.
 fn target_text(file: &FrameFile) -> String {
     match file.path.target {
-        PathTarget::LoadFactor(l) if l == 1.0 => "the full load (load factor 1)".into(),
+        PathTarget::LoadFactor(1.0) => "the full load (load factor 1)".into(),
         PathTarget::LoadFactor(l) => format!("the target load factor {l}"),
         PathTarget::Displacement {
             node,
