@@ -76,7 +76,7 @@ pub enum FdmError {
     /// An allocation of the factorisation of `D` failed: the net is larger
     /// than the memory this machine gives the run (not a numerical fault).
     #[error(
-        "out of memory factorising D = C_fᵀ Q C_f ({n_free} free nodes, {during}): \
+        "out of memory factorising D = C_fᵀ Q C_f ({n_free} free nodes, {during}){note}: \
          the net is too large for this machine; lower the net, or run where more memory is free"
     )]
     OutOfMemory {
@@ -84,6 +84,9 @@ pub enum FdmError {
         n_free: usize,
         /// Which step ran out (`symbolic factorisation`, …).
         during: &'static str,
+        /// The memory guard's estimate against its limit
+        /// ([`crate::resources::memory_note`]).
+        note: String,
     },
     /// The solve produced non-finite positions.
     #[error("the forward solve produced non-finite positions (node {node})")]
@@ -169,6 +172,7 @@ impl FdmStructure {
                 faer::sparse::FaerError::OutOfMemory => FdmError::OutOfMemory {
                     n_free: free.len(),
                     during: "symbolic factorisation",
+                    note: crate::resources::memory_note(),
                 },
                 e => FdmError::NotPositiveDefinite {
                     n_free: free.len(),
@@ -311,7 +315,11 @@ impl FdmStructure {
                 let d = SparseColMatRef::new(self.d_pattern.as_ref(), &values);
                 // Allocations that fail are the machine's memory, said as
                 // such (not a factorisation that found D indefinite).
-                let out_of_memory = |during| FdmError::OutOfMemory { n_free, during };
+                let out_of_memory = |during| FdmError::OutOfMemory {
+                    n_free,
+                    during,
+                    note: crate::resources::memory_note(),
+                };
                 let mut l_values = Vec::new();
                 l_values
                     .try_reserve_exact(symbolic.len_val())

@@ -24,6 +24,10 @@ use crate::scene::Scene;
 /// The memory limit, bytes; 0: the machine's available memory.
 static LIMIT: AtomicU64 = AtomicU64::new(0);
 
+/// The last workload checked and the limit it was checked against, bytes
+/// (0: none yet): what an allocation that fails later is compared with.
+static CHECKED: [AtomicU64; 2] = [AtomicU64::new(0), AtomicU64::new(0)];
+
 /// A workload that would not fit.
 #[derive(Debug, thiserror::Error)]
 #[error(
@@ -82,6 +86,8 @@ pub fn check_memory(key: &str, what: &str, estimate: u64) -> Result<(), MemoryEr
         },
         set => (set, false),
     };
+    CHECKED[0].store(estimate, Ordering::Relaxed);
+    CHECKED[1].store(limit, Ordering::Relaxed);
     if estimate > limit {
         return Err(MemoryError {
             key: key.to_string(),
@@ -92,6 +98,30 @@ pub fn check_memory(key: &str, what: &str, estimate: u64) -> Result<(), MemoryEr
         });
     }
     Ok(())
+}
+
+/// For a message about an allocation that failed: the guard's last
+/// estimate against its limit, and whether it was near (above half of it),
+/// e.g. `the run was estimated at 3.1 GB of the 3.5 GB available: near the
+/// limit`; empty before any check.
+pub fn memory_note() -> String {
+    let (estimate, limit) = (
+        CHECKED[0].load(Ordering::Relaxed),
+        CHECKED[1].load(Ordering::Relaxed),
+    );
+    if estimate == 0 || limit == 0 {
+        return String::new();
+    }
+    format!(
+        " (the run was estimated at about {} of the {} limit{})",
+        bytes_text(estimate),
+        bytes_text(limit),
+        if 2 * estimate > limit {
+            ": near it, the estimate is too low for this input"
+        } else {
+            "; the machine had less to give than it said"
+        }
+    )
 }
 
 /// Nodes of a scene's network (front, rear; the ties add none), before it
@@ -281,6 +311,12 @@ mod tests {
     fn a_workload_beyond_the_limit_is_refused_naming_its_key() {
         set_memory_limit(Some(1 << 30));
         let e = check_memory("front_net.rings = 815", "4 M nodes", 3 << 30).unwrap_err();
+        // An allocation failing after this check is compared with it.
+        let note = memory_note();
+        assert!(
+            note.contains("3.2 GB of the 1.1 GB limit: near it"),
+            "{note}"
+        );
         set_memory_limit(None);
         let text = e.to_string();
         assert!(
