@@ -73,6 +73,21 @@ pub enum FdmError {
         /// faer's message.
         reason: String,
     },
+    /// An allocation of the factorisation of `D` failed: the net is larger
+    /// than the memory this machine gives the run (not a numerical fault).
+    #[error(
+        "out of memory factorising D = C_fᵀ Q C_f ({n_free} free nodes, {during}){note}: \
+         the net is too large for this machine; lower the net, or run where more memory is free"
+    )]
+    OutOfMemory {
+        /// Number of free nodes.
+        n_free: usize,
+        /// Which step ran out (`symbolic factorisation`, …).
+        during: &'static str,
+        /// The memory guard's estimate against its limit
+        /// ([`crate::resources::memory_note`]).
+        note: String,
+    },
     /// The solve produced non-finite positions.
     #[error("the forward solve produced non-finite positions (node {node})")]
     NonFinite {
@@ -153,9 +168,16 @@ impl FdmStructure {
                 Default::default(),
                 Default::default(),
             )
-            .map_err(|e| FdmError::NotPositiveDefinite {
-                n_free: free.len(),
-                reason: format!("symbolic factorisation: {}", e.plain()),
+            .map_err(|e| match e {
+                faer::sparse::FaerError::OutOfMemory => FdmError::OutOfMemory {
+                    n_free: free.len(),
+                    during: "symbolic factorisation",
+                    note: crate::resources::memory_note(),
+                },
+                e => FdmError::NotPositiveDefinite {
+                    n_free: free.len(),
+                    reason: format!("symbolic factorisation: {}", e.plain()),
+                },
             })?;
             Some(Arc::new(symbolic))
         };
@@ -291,11 +313,23 @@ impl FdmStructure {
                     });
                 }
                 let d = SparseColMatRef::new(self.d_pattern.as_ref(), &values);
-                let mut l_values = vec![0.0; symbolic.len_val()];
+                // Allocations that fail are the machine's memory, said as
+                // such (not a factorisation that found D indefinite).
+                let out_of_memory = |during| FdmError::OutOfMemory {
+                    n_free,
+                    during,
+                    note: crate::resources::memory_note(),
+                };
+                let mut l_values = Vec::new();
+                l_values
+                    .try_reserve_exact(symbolic.len_val())
+                    .map_err(|_| out_of_memory("the factor"))?;
+                l_values.resize(symbolic.len_val(), 0.0);
                 let scratch = symbolic
                     .factorize_numeric_llt_scratch::<f64>(PAR, Default::default())
                     .or(symbolic.solve_in_place_scratch::<f64>(3, PAR));
-                let mut buffer = MemBuffer::new(scratch);
+                let mut buffer =
+                    MemBuffer::try_new(scratch).map_err(|_| out_of_memory("the workspace"))?;
                 let stack = MemStack::new(&mut buffer);
                 symbolic
                     .factorize_numeric_llt(

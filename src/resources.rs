@@ -24,6 +24,10 @@ use crate::scene::Scene;
 /// The memory limit, bytes; 0: the machine's available memory.
 static LIMIT: AtomicU64 = AtomicU64::new(0);
 
+/// The last workload checked and the limit it was checked against, bytes
+/// (0: none yet): what an allocation that fails later is compared with.
+static CHECKED: [AtomicU64; 2] = [AtomicU64::new(0), AtomicU64::new(0)];
+
 /// A workload that would not fit.
 #[derive(Debug, thiserror::Error)]
 #[error(
@@ -82,6 +86,8 @@ pub fn check_memory(key: &str, what: &str, estimate: u64) -> Result<(), MemoryEr
         },
         set => (set, false),
     };
+    CHECKED[0].store(estimate, Ordering::Relaxed);
+    CHECKED[1].store(limit, Ordering::Relaxed);
     if estimate > limit {
         return Err(MemoryError {
             key: key.to_string(),
@@ -94,6 +100,30 @@ pub fn check_memory(key: &str, what: &str, estimate: u64) -> Result<(), MemoryEr
     Ok(())
 }
 
+/// For a message about an allocation that failed: the guard's last
+/// estimate against its limit, and whether it was near (above half of it),
+/// e.g. `the run was estimated at 3.1 GB of the 3.5 GB available: near the
+/// limit`; empty before any check.
+pub fn memory_note() -> String {
+    let (estimate, limit) = (
+        CHECKED[0].load(Ordering::Relaxed),
+        CHECKED[1].load(Ordering::Relaxed),
+    );
+    if estimate == 0 || limit == 0 {
+        return String::new();
+    }
+    format!(
+        " (the run was estimated at about {} of the {} limit{})",
+        bytes_text(estimate),
+        bytes_text(limit),
+        if 2 * estimate > limit {
+            ": near it, the estimate is too low for this input"
+        } else {
+            "; the machine had less to give than it said"
+        }
+    )
+}
+
 /// Nodes of a scene's network (front, rear; the ties add none), before it
 /// is built.
 pub fn scene_nodes(scene: &Scene) -> u64 {
@@ -104,24 +134,83 @@ pub fn scene_nodes(scene: &Scene) -> u64 {
 /// Memory of one command's workload on `scene`, bytes (see the module
 /// documentation).
 pub fn scene_memory(scene: &Scene, command: SceneCommand) -> u64 {
-    let nodes = scene_nodes(scene);
+    net_memory(scene_nodes(scene), command)
+}
+
+/// Memory of one command's workload on a net of `nodes` nodes, bytes: the
+/// one estimate behind [`scene_memory`] and [`network_memory`] (see the
+/// module documentation).
+pub fn net_memory(nodes: u64, command: SceneCommand) -> u64 {
     let (base, per_node) = match command {
         SceneCommand::Mesh => (16 << 20, 1_200),
-        SceneCommand::Optimize => (32 << 20, 3_600),
+        SceneCommand::Optimize | SceneCommand::Truss => (32 << 20, 3_600),
         SceneCommand::Design => (100 << 20, 21_000),
     };
     base + nodes.saturating_mul(per_node)
 }
 
+/// Memory of one command's workload on an interchange-format network of
+/// `nodes` nodes and `edges` cables, bytes: [`net_memory`] of the nodes,
+/// or of a third of the cables when they are more (a reflector net has
+/// about three cables a node; a denser graph costs as its cables do).
+pub fn network_memory(nodes: u64, edges: u64, command: SceneCommand) -> u64 {
+    net_memory(nodes.max(edges / 3), command)
+}
+
 /// The workloads [`scene_memory`] estimates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SceneCommand {
-    /// Building and writing the network.
+    /// Building and writing the network (`mesh`; `fdm`'s one solve).
     Mesh,
-    /// One uniformity solve.
+    /// One uniformity solve (`optimize`, `uniformity`).
     Optimize,
+    /// The net built and solved once for its pull on the truss (`truss`):
+    /// as [`SceneCommand::Optimize`], the truss's few elements aside.
+    Truss,
     /// The outer loop, its verification and limit search.
     Design,
+}
+
+/// Checks `command`'s workload on an interchange-format network read from
+/// `path` ([`network_memory`]), naming the file and its size.
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_network(
+    path: &std::path::Path,
+    nodes: usize,
+    edges: usize,
+    command: SceneCommand,
+) -> Result<(), MemoryError> {
+    check_memory(
+        &path.display().to_string(),
+        &format!("{nodes} nodes, {edges} cables"),
+        network_memory(nodes as u64, edges as u64, command),
+    )
+}
+
+/// Checks `command`'s workload on `scene` with the refusal naming `key`
+/// before the net (an aperture of a sweep, say: `--apertures 1000`).
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_scene_for(scene: &Scene, command: SceneCommand, key: &str) -> Result<(), MemoryError> {
+    check_scene_as(scene, command, 1, None).map_err(|mut e| {
+        e.key = format!("{key}: {}", e.key);
+        e
+    })
+}
+
+/// Checks a frame of `elements` elements ([`frame_memory`]), naming `key`.
+///
+/// # Errors
+/// [`MemoryError`].
+pub fn check_frame(key: &str, elements: usize) -> Result<(), MemoryError> {
+    check_memory(
+        key,
+        &format!("{elements} elements"),
+        frame_memory(elements as u64),
+    )
 }
 
 /// Checks `command`'s workload on `scene`, naming `front_net.rings`;
@@ -222,6 +311,12 @@ mod tests {
     fn a_workload_beyond_the_limit_is_refused_naming_its_key() {
         set_memory_limit(Some(1 << 30));
         let e = check_memory("front_net.rings = 815", "4 M nodes", 3 << 30).unwrap_err();
+        // An allocation failing after this check is compared with it.
+        let note = memory_note();
+        assert!(
+            note.contains("3.2 GB of the 1.1 GB limit: near it"),
+            "{note}"
+        );
         set_memory_limit(None);
         let text = e.to_string();
         assert!(

@@ -302,9 +302,20 @@ pub fn shard_csv(header: &ShardHeader, columns: &str, rows: &[(usize, String)]) 
 /// I/O, or a file without the shard header, the `point` column or valid
 /// point indices.
 pub fn read_shard(path: &Path) -> Result<ShardFile, ShardError> {
-    let text = crate::input::read_input(path).map_err(|source| ShardError::Io {
-        path: path.to_path_buf(),
-        source,
+    let text = crate::input::read_input(path).map_err(|source| {
+        if source.kind() == std::io::ErrorKind::InvalidData {
+            // Read, but not text (or too large): the file's fault, not the
+            // machine's.
+            ShardError::Format {
+                path: path.to_path_buf(),
+                reason: source.to_string(),
+            }
+        } else {
+            ShardError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        }
     })?;
     let format = |reason: String| ShardError::Format {
         path: path.to_path_buf(),

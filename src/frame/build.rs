@@ -35,11 +35,49 @@ fn vector(key: &str, v: [f64; 3]) -> Result<Vector3<f64>, FrameFileError> {
 
 fn nonzero(key: &str, v: [f64; 3]) -> Result<Vector3<f64>, FrameFileError> {
     let v = vector(key, v)?;
-    if v.norm() > 0.0 {
+    if v.norm().is_normal() {
         Ok(v)
+    } else if v.amax() > 0.0 {
+        // A direction whose norm overflows (1e300) or underflows (1e-320):
+        // scaled by its largest component.
+        Ok(v / v.amax())
     } else {
         Err(FrameFileError::invalid(key, "must be a non-zero vector"))
     }
+}
+
+/// A rod's `up` (its section's second axis) must leave the rod's axis: one
+/// along it orients no section. Given, it is refused; defaulted (`z`) on a
+/// rod along `z`, it is refused when the section's two bending stiffnesses
+/// differ (with equal ones the section's orientation changes nothing).
+fn check_up(
+    key: &str,
+    label: &str,
+    axis: Vector3<f64>,
+    up: Vector3<f64>,
+    given: bool,
+    section: &Section,
+) -> Result<(), FrameFileError> {
+    let (a, u) = (axis / axis.amax(), up / up.amax());
+    let along = a.cross(&u).norm() <= 1e-8 * a.norm() * u.norm();
+    if !along || (!given && section.bending_nm2[0] == section.bending_nm2[1]) {
+        return Ok(());
+    }
+    Err(FrameFileError::invalid(
+        format!("{key}.up"),
+        if given {
+            format!(
+                "[{}, {}, {}] is along rod \"{label}\": `up` orients the section's second axis \
+                 and must leave the rod's axis",
+                up[0], up[1], up[2]
+            )
+        } else {
+            format!(
+                "missing: rod \"{label}\" runs along z, the default `up`, and its bending \
+                 stiffnesses differ: give the direction of the section's second axis"
+            )
+        },
+    ))
 }
 
 fn positive(key: &str, v: f64) -> Result<(), FrameFileError> {
@@ -481,11 +519,24 @@ pub(super) fn build(raw: RawFile) -> Result<FrameFile, FrameFileError> {
             elements: r.elements,
             kind: r.element,
         };
-        let rod = match &r.arc {
-            Some(raw) => {
-                let arc = arc(&key, raw, p, q, r.elements)?;
-                builder.add_arc_rod(p, q, &arc, up, &spec)
-            }
+        let arc = match &r.arc {
+            Some(raw) => Some(arc(&key, raw, p, q, r.elements)?),
+            None => None,
+        };
+        // The rod's axis at its start: along the chord, or the arc's
+        // tangent (an invalid arc is the builder's error, naming it).
+        let axis = match &arc {
+            Some(a) => a
+                .geometry(p, q)
+                .ok()
+                .map(|g| g.axis.cross(&(p - g.centre_m))),
+            None => Some(q - p),
+        };
+        if let Some(axis) = axis {
+            check_up(&key, &label, axis, up, r.up.is_some(), &section)?;
+        }
+        let rod = match &arc {
+            Some(arc) => builder.add_arc_rod(p, q, arc, up, &spec),
             None => builder.add_rod(p, q, up, &spec),
         };
         origins.extend((0..rod.nodes.len()).map(|index| NodeOrigin::Rod {

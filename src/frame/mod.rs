@@ -33,7 +33,9 @@
 //!   either `section = "NAME"`, or `tube = { … }`, or the four stiffnesses
 //!   written on the rod. `elements` (default 1), `element = "se3"` (default) or
 //!   `"crisfield-jelenic"`, optional `up` (the second axis of the section is the
-//!   one closest to `up`; default `[0, 0, 1]`), optional `name`. Every rod is
+//!   one closest to `up`; default `[0, 0, 1]`; one along the rod is refused,
+//!   and so is the default on a rod along z whose two bending stiffnesses
+//!   differ), optional `name`. Every rod is
 //!   meshed with nodes of its own: its ends are connected to anything else only
 //!   by joints.
 //! * `arc` on a rod — the rod follows a circular arc from `start` to `end`:
@@ -75,7 +77,8 @@
 //! * `[path]` — where the path ends, `target = { load_factor = 1.0 }` (the
 //!   default), `{ on = MEMBER, component = "x" | "y" | "z", displacement_m
 //!   = … }` or `{ steps = N }`; `control = { on = MEMBER, component = … }`,
-//!   the translation `path = "displacement"` drives. Load control ends at
+//!   the translation `path = "displacement"` drives (refused under another
+//!   path, which would ignore it). Load control ends at
 //!   the full load (or a limit point); arc length follows the path through
 //!   limit points in load and displacement, across λ ≤ 0 and back.
 //! * `[output]` — `nodes = ["tip", { rod = "beam", end = "end" }, …]`: the

@@ -163,10 +163,17 @@ impl CircularArc {
                 if !finite(&n) {
                     return Err(fault(ArcInput::Normal, "a component is not finite"));
                 }
-                if n.norm() == 0.0 {
+                if n.amax() == 0.0 {
                     return Err(fault(ArcInput::Normal, "must be a non-zero vector"));
                 }
-                n
+                // A direction of any finite length: one whose norm
+                // overflows (1e300) or underflows (1e-320) is scaled by its
+                // largest component first.
+                if n.norm().is_normal() {
+                    n
+                } else {
+                    n / n.amax()
+                }
             }
             None => {
                 let n = a.cross(&b);

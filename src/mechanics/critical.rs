@@ -9,12 +9,18 @@
 //!   is extremal. The load factor there is the path's extremum, accurate
 //!   to the square of the fraction's error. A sign change where the slope
 //!   is at noise level at both ends ([`SLOPE_NOISE`]) is not one;
-//! * a bifurcation point: the lowest eigenvalue of the stiffness on the
-//!   joints' constraints ([`super::stability::lowest_eigenpair`]), when it
-//!   changes sign with no load extremum in the step. A sign change that
-//!   does not shrink towards zero as the fraction closes in is the least
-//!   eigenvalue changing from one mode to another, not a crossing, and is
-//!   dropped;
+//! * a bifurcation point: a change of the tangent's inertia, the number of
+//!   negative eigenvalues of the stiffness on the joints' constraints
+//!   ([`super::stability::negative_eigenvalues`]), with no load extremum in
+//!   the step: an eigenvalue crossed zero. It is located on the eigenvalue
+//!   that changes sign — the least-magnitude eigenvalue
+//!   ([`super::stability::lowest_eigenpair`]) signed by the inertia, so
+//!   that a switch of the least eigenvalue between two modes of opposite
+//!   signs, the inertia unchanged, is no crossing, and near the crossing
+//!   the least eigenvalue is the crossing one. Where the inertia is not
+//!   counted (a tangent above [`super::stability::INERTIA_ROWS`] rows) the
+//!   least eigenvalue's own sign change is the test, and one that does not
+//!   shrink towards zero as the fraction closes in is dropped;
 //! * the target: the load factor or a node's displacement minus its value.
 //!
 //! At a bifurcation the path may leave for the other branch: one arc-length
@@ -24,7 +30,7 @@
 use super::corrector::{Constraint, Corrected};
 use super::follower::{load_slope, Control, Follower, Node, Run};
 use super::path_spec::{CriticalKind, CriticalPoint, PathTarget};
-use super::stability::{lowest_eigenpair, translations};
+use super::stability::{lowest_eigenpair, negative_eigenvalues, translations};
 
 /// Largest number of re-solved fractions in one location.
 const MAX_LOCATE: usize = 80;
@@ -214,22 +220,49 @@ pub(super) fn between(
             .push(critical_point(follower, kind, &node, after_point, false));
         return None;
     }
-    let (Some(m0), Some(m1)) = (from.indicators.eigenvalue, to.indicators.eigenvalue) else {
-        return None;
+    let solver = follower.corrector.solver;
+    let node = match (from.indicators.negative, to.indicators.negative) {
+        (Some(n0), Some(n1)) => {
+            if n0 == n1 {
+                // No eigenvalue crossed zero, whatever the least one did.
+                return None;
+            }
+            // The crossing eigenvalue: the least in magnitude, positive
+            // while the inertia is the start's.
+            let size = |e: Option<f64>| e.map_or(1.0, f64::abs);
+            let (f0, f1) = (
+                size(from.indicators.eigenvalue),
+                -size(to.indicators.eigenvalue),
+            );
+            let crossing = |s: &Corrected| {
+                let n = negative_eigenvalues(solver, &s.state, s.lambda)?;
+                let least = lowest_eigenpair(solver, &s.state, s.lambda).ok()?;
+                let sign = if n == n0 { 1.0 } else { -1.0 };
+                Some(sign * least.eigenvalue.abs())
+            };
+            let (step, _) = locate(follower, from, previous, h, (f0, f1), crossing)?;
+            follower.node(&step)?
+        }
+        _ => {
+            let (Some(m0), Some(m1)) = (from.indicators.eigenvalue, to.indicators.eigenvalue)
+            else {
+                return None;
+            };
+            if m0 * m1 >= 0.0 {
+                return None;
+            }
+            let eigenvalue = |s: &Corrected| {
+                lowest_eigenpair(solver, &s.state, s.lambda)
+                    .ok()
+                    .map(|pair| pair.eigenvalue)
+            };
+            let (step, value) = locate(follower, from, previous, h, (m0, m1), eigenvalue)?;
+            if value.abs() > CROSSING * m0.abs().max(m1.abs()) {
+                return None;
+            }
+            follower.node(&step)?
+        }
     };
-    if m0 * m1 >= 0.0 {
-        return None;
-    }
-    let eigenvalue = |s: &Corrected| {
-        lowest_eigenpair(follower.corrector.solver, &s.state, s.lambda)
-            .ok()
-            .map(|pair| pair.eigenvalue)
-    };
-    let (step, value) = locate(follower, from, previous, h, (m0, m1), eigenvalue)?;
-    let node = follower.node(&step)?;
-    if value.abs() > CROSSING * m0.abs().max(m1.abs()) {
-        return None;
-    }
     let branch = if switch {
         switch_branch(follower, &node, h)
     } else {

@@ -9,7 +9,7 @@ use super::corrector::{Constraint, Corrected, Corrector};
 use super::node::NodeId;
 use super::path_spec::{CriticalPoint, PathPoint};
 use super::settings::StepRecord;
-use super::stability::lowest_eigenpair;
+use super::stability::{lowest_eigenpair, negative_eigenvalues};
 
 /// A converged point of the path and what the next step needs of it.
 #[derive(Clone)]
@@ -146,22 +146,28 @@ impl Follower<'_> {
             load_factor: node.lambda,
             displacements_m: self.displacements(&node.state),
             lowest_stiffness_n_per_m: node.indicators.eigenvalue,
+            negative_eigenvalues: node.indicators.negative,
             iterations,
         }
     }
 
     /// The path point of an equilibrium `(state, lambda)` reached in
-    /// `iterations`, its lowest eigenvalue computed if asked for.
+    /// `iterations`, its lowest eigenvalue and inertia computed if asked
+    /// for.
     pub fn point_at(&self, state: &State, lambda: f64, iterations: usize) -> PathPoint {
         let lowest = self.stability.then(|| {
             lowest_eigenpair(self.corrector.solver, state, lambda)
                 .ok()
                 .map(|pair| pair.eigenvalue)
         });
+        let negative = self
+            .stability
+            .then(|| negative_eigenvalues(self.corrector.solver, state, lambda));
         PathPoint {
             load_factor: lambda,
             displacements_m: self.displacements(state),
             lowest_stiffness_n_per_m: lowest.flatten(),
+            negative_eigenvalues: negative.flatten(),
             iterations,
         }
     }
@@ -207,6 +213,9 @@ pub(super) struct Indicators {
     pub eigenvalue: Option<f64>,
     /// Its eigenvector, unknown order, weighted norm 1.
     pub vector: Option<Vec<f64>>,
+    /// How many eigenvalues on the constraints are negative: the tangent's
+    /// inertia ([`negative_eigenvalues`]; `None` where not counted).
+    pub negative: Option<usize>,
 }
 
 /// The indicators at `(state, lambda)` with tangent `t`, reached by the
@@ -226,10 +235,15 @@ pub(super) fn indicators(
     } else {
         (None, None)
     };
+    let negative = follower
+        .stability
+        .then(|| negative_eigenvalues(follower.corrector.solver, state, lambda))
+        .flatten();
     Indicators {
         load_slope: load_slope(follower, t, previous),
         eigenvalue,
         vector,
+        negative,
     }
 }
 

@@ -18,9 +18,11 @@
 //!   the load factor's change per step at most `max_step`; a step that
 //!   fails is cut ÷4 down to `min_step`.
 //! * Critical points ([`super::critical`]): a sign change of the load's
-//!   derivative along the path is a limit point, one of the lowest
-//!   eigenvalue without it a bifurcation; each is located between its two
-//!   steps by re-solving the step to a fraction of its length.
+//!   derivative along the path is a limit point, a change of the tangent's
+//!   inertia without it a bifurcation (under load control too); each is
+//!   located between its two steps by re-solving the step to a fraction of
+//!   its length. The last point's inertia says whether the path ended on
+//!   an unstable branch.
 
 use std::time::Instant;
 
@@ -80,6 +82,21 @@ impl StaticSolver {
             return bad(
                 "solver.branch_switch",
                 "leaving a bifurcation for its branch needs path = \"arc_length\"".into(),
+            );
+        }
+        if spec.control.is_some() && settings.path != PathControl::Displacement {
+            // The controlled translation drives displacement control only:
+            // under another control it would be ignored.
+            return bad(
+                "path.control",
+                format!(
+                    "drives displacement control only, and the solver's path is {}: remove \
+                     it, or set path = \"displacement\"",
+                    match settings.path {
+                        PathControl::Load => "\"load\"",
+                        _ => "\"arc_length\"",
+                    }
+                ),
             );
         }
         if let PathTarget::Steps(0) = spec.target {
@@ -243,6 +260,7 @@ impl StaticSolver {
             solution,
             points: run.points,
             critical_points: run.critical_points,
+            final_negative_eigenvalues: node.indicators.negative,
         })
     }
 }
@@ -251,8 +269,13 @@ impl StaticSolver {
     /// [`StaticSolver::follow_path`] under load control: the load ramped to
     /// λ = 1 by [`super::load_control`] (its branch tests end the path at a
     /// limit load instead of snapping through), every accepted step
-    /// recorded. No critical point is located: the termination says where a
-    /// limit stopped it; arc length follows through and locates.
+    /// recorded. Load control stays on the branch it started on, past any
+    /// bifurcation: with the stability test, the tangent's inertia at every
+    /// converged step shows each one passed, located between its two steps
+    /// as under arc length ([`critical::between`]), and the last point's
+    /// inertia says whether the path ended on an unstable branch. A limit
+    /// point ends the path (its termination says where); arc length follows
+    /// through it.
     fn follow_load(
         &self,
         spec: &PathSpec,
@@ -276,21 +299,65 @@ impl StaticSolver {
             start_slope: 1.0,
         };
         let start = self.reference_state();
-        let mut points = vec![follower.point_at(&start, 0.0, 0)];
+        let mut run = Run {
+            points: vec![follower.point_at(&start, 0.0, 0)],
+            critical_points: Vec::new(),
+            steps: Vec::new(),
+            newton_iterations: 0,
+            rejected_steps: 0,
+            reactions: Vec::new(),
+        };
+        // The last converged node, kept only to locate a critical point in
+        // the next step (with the stability test).
+        let node_at = |state: &super::assembly::State, lambda: f64| {
+            let tangent = follower.corrector.tangent(state, lambda)?;
+            let indicators = indicators(&follower, state, lambda, &tangent, None);
+            Some(Node {
+                state: state.clone(),
+                lambda,
+                tangent,
+                indicators,
+            })
+        };
+        let mut last = if settings.stability {
+            node_at(&start, 0.0)
+        } else {
+            None
+        };
+        let mut final_negative = last.as_ref().and_then(|n| n.indicators.negative);
         let mut solution = super::load_control::follow_observed(
             self,
             start,
             0.0,
             settings,
             &mut |state, lambda, iterations| {
-                points.push(follower.point_at(state, lambda, iterations))
+                if !settings.stability {
+                    run.points
+                        .push(follower.point_at(state, lambda, iterations));
+                    return;
+                }
+                let Some(node) = node_at(state, lambda) else {
+                    run.points
+                        .push(follower.point_at(state, lambda, iterations));
+                    last = None;
+                    final_negative = None;
+                    return;
+                };
+                run.points.push(follower.point(&node, iterations));
+                if let Some(from) = &last {
+                    let h = node.lambda - from.lambda;
+                    critical::between(&follower, &mut run, from, None, h, &node, false);
+                }
+                final_negative = node.indicators.negative;
+                last = Some(node);
             },
         );
         solution.time_s = clock.elapsed().as_secs_f64();
         Ok(PathSolution {
             solution,
-            points,
-            critical_points: Vec::new(),
+            points: run.points,
+            critical_points: run.critical_points,
+            final_negative_eigenvalues: final_negative,
         })
     }
 }

@@ -54,6 +54,10 @@ pub struct PathPoint {
     /// (signed, rotations × the mean element length), N/m; `None` without
     /// the stability test.
     pub lowest_stiffness_n_per_m: Option<f64>,
+    /// How many eigenvalues of that stiffness are negative (the tangent's
+    /// inertia: 0 on a stable branch); `None` without the stability test
+    /// or for a tangent too large to count (above 1 000 rows).
+    pub negative_eigenvalues: Option<usize>,
     /// Newton iterations of the step that reached it.
     pub iterations: usize,
 }
@@ -66,8 +70,9 @@ pub enum CriticalKind {
     LimitMaximum,
     /// A load minimum along the path.
     LimitMinimum,
-    /// The lowest eigenvalue crosses zero with no load extremum: another
-    /// branch of equilibria crosses the path here.
+    /// An eigenvalue crosses zero with no load extremum (the tangent's
+    /// inertia changes): another branch of equilibria crosses the path
+    /// here.
     Bifurcation,
 }
 
@@ -111,4 +116,9 @@ pub struct PathSolution {
     pub points: Vec<PathPoint>,
     /// Limit and bifurcation points, in path order.
     pub critical_points: Vec<CriticalPoint>,
+    /// How many eigenvalues of the stiffness on the constraints are
+    /// negative at the last point: more than 0, the path ended on an
+    /// unstable branch (past a bifurcation it did not leave); `None` where
+    /// not counted.
+    pub final_negative_eigenvalues: Option<usize>,
 }

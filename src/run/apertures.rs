@@ -5,7 +5,10 @@ use std::path::{Path, PathBuf};
 
 use super::{read_scene, Summary};
 use crate::report::{aperture_csv, aperture_plot, readable, write_atomic, write_json, OutputSet};
-use crate::study::{run_aperture_study, value_name, ApertureResult, ApertureSettings};
+use crate::resources::{check_scene_for, SceneCommand};
+use crate::study::{
+    run_aperture_study, scaled_scenes, value_name, ApertureResult, ApertureSettings,
+};
 use crate::Error;
 
 /// What `ringmesh apertures` made.
@@ -87,6 +90,12 @@ pub fn apertures(
         "apertures.csv",
         "apertures.json",
     ];
+    // One aperture at a time: the sweep's peak is its largest aperture's
+    // design, each checked before anything is computed.
+    for scaled in scaled_scenes(&scene, &settings.apertures_m)? {
+        let key = format!("--apertures {}", scaled.reflector.aperture_diameter_m);
+        check_scene_for(&scaled, SceneCommand::Design, &key)?;
+    }
     let mut set = OutputSet::begin(&dir, &table)?;
     let results = run_aperture_study(&scene, settings, observe)?;
     for r in &results {

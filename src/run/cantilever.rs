@@ -129,6 +129,7 @@ pub fn cantilever(
     kind: ElementKind,
     output: Option<&Path>,
 ) -> Result<CantileverTable, Error> {
+    crate::resources::check_frame(&format!("--elements {elements}"), elements)?;
     let target = output
         .map(|o| OutputPath::resolve(o).map(|t| t.folder_and_name("cantilever.json")))
         .transpose()?;

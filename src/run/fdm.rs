@@ -8,6 +8,7 @@ use super::Summary;
 use crate::fdm::solve_network;
 use crate::network::Network;
 use crate::report::{json_bytes, OutputPath, OutputSet};
+use crate::resources::{check_network, SceneCommand};
 use crate::Error;
 
 /// The output of `ringmesh fdm`.
@@ -51,6 +52,12 @@ pub fn fdm(network_path: &Path, output_path: &Path) -> Result<FdmOutcome, Error>
     let (dir, name) = OutputPath::resolve(output_path)?.folder_and_name("fdm.json");
     OutputSet::check_folder(&dir)?;
     let network = Network::read_json(network_path)?;
+    check_network(
+        network_path,
+        network.n_nodes(),
+        network.edges.len(),
+        SceneCommand::Mesh,
+    )?;
     let (_, equilibrium) = solve_network(&network)?;
     let output = FdmOutput {
         max_residual: equilibrium.max_residual_n(),

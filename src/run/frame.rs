@@ -9,7 +9,8 @@ use super::Summary;
 use crate::algebra::norm3;
 use crate::frame::{FrameFile, FrameFileError, NodeOrigin};
 use crate::mechanics::{
-    rotation, CriticalPoint, MechanicsError, PathPoint, StaticSolver, StaticTermination, StepRecord,
+    rotation, CriticalKind, CriticalPoint, MechanicsError, PathPoint, PathTarget, StaticSolver,
+    StaticTermination, StepRecord,
 };
 use crate::report::{
     json_name, path_plot, readable, write_atomic, write_json, OutputPath, OutputSet, PathFigure,
@@ -105,6 +106,13 @@ pub struct FrameOutput {
     pub path: FramePath,
     /// Limit and bifurcation points located on the path, in path order.
     pub critical_points: Vec<CriticalPoint>,
+    /// The path's target, in words (`the full load (load factor 1)`, `the
+    /// y displacement -0.5 m of rod beam node 10`, `40 steps`).
+    pub target: String,
+    /// How many eigenvalues of the stiffness on the joints' constraints
+    /// are negative at the last point (the tangent's inertia): more than
+    /// 0, the path ended on an unstable branch; `None` where not counted.
+    pub final_negative_eigenvalues: Option<usize>,
 }
 
 /// The size of a frame.
@@ -132,12 +140,30 @@ pub fn default_frame_output(frame_path: &Path) -> PathBuf {
 }
 
 impl FrameOutput {
-    /// Why the run ended before its target (by default the full load), or
-    /// `None` when it reached it. The CLI exits 3 then, after writing what it found.
+    /// Why the run ended before its target (named), or reached it on an
+    /// unstable branch (past a bifurcation it did not leave: not a plain
+    /// success); `None` when it reached it on a stable one. The CLI exits 3
+    /// then, after writing what it found.
     pub fn ended_early(&self) -> Option<String> {
         match self.termination {
-            StaticTermination::Converged => None,
-            ref t => Some(format!("ended before the full load: {t}")),
+            StaticTermination::Converged => {
+                let negative = self.final_negative_eigenvalues.filter(|&n| n > 0)?;
+                let past = self
+                    .critical_points
+                    .iter()
+                    .rfind(|c| c.kind == CriticalKind::Bifurcation && !c.switched_branch)
+                    .map(|c| format!(", past the bifurcation at load factor {:.9}", c.load_factor))
+                    .unwrap_or_default();
+                Some(format!(
+                    "reached {} on an UNSTABLE branch: the stiffness there has {negative} \
+                     negative eigenvalue{}{past}; the equilibrium is not one the frame keeps \
+                     (follow the path by arc length with branch_switch = true for the stable \
+                     branch)",
+                    self.target,
+                    if negative == 1 { "" } else { "s" }
+                ))
+            }
+            ref t => Some(format!("ended before {}: {t}", self.target)),
         }
     }
 }
@@ -236,6 +262,26 @@ fn frame_summary(o: &FrameOutput) -> String {
             )
         })
         .collect::<String>()
+}
+
+/// The frame file's path target, in words.
+fn target_text(file: &FrameFile) -> String {
+    match file.path.target {
+        PathTarget::LoadFactor(1.0) => "the full load (load factor 1)".into(),
+        PathTarget::LoadFactor(l) => format!("the target load factor {l}"),
+        PathTarget::Displacement {
+            node,
+            component,
+            value_m,
+        } => format!(
+            "the target {} displacement {value_m} m of {}",
+            ["x", "y", "z"].get(component).unwrap_or(&"?"),
+            file.nodes_origins
+                .get(node)
+                .map_or_else(|| format!("node {node}"), ToString::to_string)
+        ),
+        PathTarget::Steps(n) => format!("the target of {n} steps"),
+    }
 }
 
 /// `ringmesh frame`: reads a frame file, follows its equilibrium path to
@@ -365,6 +411,8 @@ pub fn frame(frame_path: &Path, output_path: Option<&Path>) -> Result<FrameOutco
             points: followed.points,
         },
         critical_points: followed.critical_points,
+        target: target_text(&file),
+        final_negative_eigenvalues: followed.final_negative_eigenvalues,
     };
     let finite_path = output.path.points.iter().all(|p| {
         p.load_factor.is_finite() && p.displacements_m.iter().flatten().all(|v| v.is_finite())

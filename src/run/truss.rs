@@ -65,6 +65,7 @@ pub fn truss(
     };
     OutputSet::check_folder(&target.folder_and_name("").0)?;
     let model = model.unwrap_or(scene.effects.truss);
+    crate::resources::check_scene(&scene, crate::resources::SceneCommand::Truss, 1)?;
     let loads = match loads_path {
         Some(p) => Some((p.display().to_string(), crate::truss::read_loads(p)?)),
         None => None,

@@ -98,6 +98,12 @@ pub fn uniformity(
     let (dir, file_name) = OutputPath::resolve(output_path)?.folder_and_name("uniformity.json");
     OutputSet::check_folder(&dir)?;
     let network = Network::read_json(network_path)?;
+    crate::resources::check_network(
+        network_path,
+        network.n_nodes(),
+        network.edges.len(),
+        crate::resources::SceneCommand::Optimize,
+    )?;
     let output = uniformity_of(
         network,
         solver,

@@ -40,5 +40,6 @@ pub use schema::{
     Supports, SurfaceSpec, Truss, TrussModel, UniformNet, Uniformity,
 };
 pub use validate::{
-    MAX_BAYS, MAX_ELEMENTS_PER_ROD, MAX_HEIGHT_RATIO, MAX_MODULUS_PA, MAX_NAME_LEN,
+    modulus_range, MAX_BAYS, MAX_ELEMENTS_PER_ROD, MAX_HEIGHT_RATIO, MAX_MODULUS_PA, MAX_NAME_LEN,
+    MIN_MODULUS_PA,
 };

@@ -11,6 +11,11 @@ pub const MAX_NAME_LEN: usize = 128;
 /// Largest elastic modulus a scene may give, Pa (diamond: 1.2e12).
 pub const MAX_MODULUS_PA: f64 = 1e13;
 
+/// Smallest elastic modulus a scene may give, Pa (soft rubber: 1e6): a
+/// softer truss or cable carries nothing, and 1e-300 left the truss's
+/// tangent a mechanism to roundoff.
+pub const MIN_MODULUS_PA: f64 = 1e6;
+
 /// Tallest truss, as a multiple of the aperture diameter (real rings:
 /// 0.1–0.6).
 pub const MAX_HEIGHT_RATIO: f64 = 10.0;
@@ -279,10 +284,24 @@ fn one_tension_of(
 /// any material; 1e300 made the truss's Newton 'converge' in 0 iterations).
 fn modulus(key: &'static str, value: f64) -> Result<(), SceneError> {
     positive(key, value)?;
+    modulus_range(value).map_err(|reason| SceneError::invalid(key, reason))
+}
+
+/// Why a finite positive modulus, Pa, is outside
+/// [[`MIN_MODULUS_PA`], [`MAX_MODULUS_PA`]]: the scene's rule, which a
+/// tube catalogue's line follows too.
+///
+/// # Errors
+/// The reason, in words.
+pub fn modulus_range(value: f64) -> Result<(), String> {
     if value > MAX_MODULUS_PA {
-        return Err(SceneError::invalid(
-            key,
-            format!("{value:e} Pa is stiffer than any material (at most {MAX_MODULUS_PA:e} Pa)"),
+        return Err(format!(
+            "{value:e} Pa is stiffer than any material (at most {MAX_MODULUS_PA:e} Pa)"
+        ));
+    }
+    if value < MIN_MODULUS_PA {
+        return Err(format!(
+            "{value:e} Pa is softer than any structural material (at least {MIN_MODULUS_PA:e} Pa)"
         ));
     }
     Ok(())

@@ -113,8 +113,10 @@ pub fn read(path: &Path, truss: &Truss) -> Result<Vec<TubeSection>, SizingError>
 ///
 /// # Errors
 /// A bad header, a row with the wrong number of fields, a value that is not
-/// a finite number `> 0`, an inner diameter not below the outer one, or no
-/// row; each names the line.
+/// a finite number `> 0` (the inner diameter `>= 0`: a solid rod is a
+/// section, as in a scene), a modulus outside the scene's range
+/// ([`crate::scene::modulus_range`]), an inner diameter not below the
+/// outer one, or no row; each names the line.
 pub fn parse(text: &str, source: &str, truss: &Truss) -> Result<Vec<TubeSection>, SizingError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let error = |line: usize, reason: String| SizingError::Catalogue {
@@ -149,15 +151,21 @@ pub fn parse(text: &str, source: &str, truss: &Truss) -> Result<Vec<TubeSection>
         }
         let mut values = [0.0, 0.0, truss.youngs_modulus_pa, truss.density_kg_per_m3];
         for (k, field) in fields.iter().enumerate() {
+            // A solid rod (inner diameter 0) is a section, as in a scene.
+            let least = if k == 1 { 0.0 } else { f64::MIN_POSITIVE };
             values[k] = match field.parse::<f64>() {
-                Ok(v) if v.is_finite() && v > 0.0 => v,
+                Ok(v) if v.is_finite() && v >= least => v,
                 _ => {
+                    let bound = if k == 1 { ">= 0" } else { "> 0" };
                     return Err(error(
                         line,
-                        format!("`{}` = `{field}`: not a finite number > 0", COLUMNS[k]),
-                    ))
+                        format!("`{}` = `{field}`: not a finite number {bound}", COLUMNS[k]),
+                    ));
                 }
             };
+        }
+        if let Err(reason) = crate::scene::modulus_range(values[2]) {
+            return Err(error(line, format!("`youngs_modulus_pa`: {reason}")));
         }
         let [outer_diameter_m, inner_diameter_m, youngs_modulus_pa, density_kg_per_m3] = values;
         if inner_diameter_m >= outer_diameter_m {

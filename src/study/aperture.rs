@@ -49,7 +49,10 @@ pub fn scaled(scene: &Scene, aperture_m: f64) -> Result<Scene, SizingError> {
     if !(aperture_m.is_finite() && aperture_m > 0.0 && aperture_m <= MAX_APERTURE_M) {
         return Err(SizingError::Scene {
             key: "apertures",
-            reason: format!("{aperture_m} m: an aperture is a number in (0, {MAX_APERTURE_M}] m"),
+            reason: format!(
+                "{} m: an aperture is a number in (0, {MAX_APERTURE_M}] m",
+                number(aperture_m)
+            ),
         });
     }
     if scene.effects.rod_properties_csv.is_some() {
@@ -59,6 +62,22 @@ pub fn scaled(scene: &Scene, aperture_m: f64) -> Result<Scene, SizingError> {
         });
     }
     let s = aperture_m / scene.reflector.aperture_diameter_m;
+    let rings = (scene.front_net.rings as f64 * s).round();
+    if rings < 2.0 {
+        // The net keeps its facets: too small an aperture has no net.
+        return Err(SizingError::Scene {
+            key: "apertures",
+            reason: format!(
+                "{} m: the net of {} rings at {} m keeps its facet size, {} rings at \
+                 this aperture; a net has at least 2: the smallest aperture is {} m",
+                number(aperture_m),
+                scene.front_net.rings,
+                scene.reflector.aperture_diameter_m,
+                rings,
+                1.5 * scene.reflector.aperture_diameter_m / scene.front_net.rings as f64
+            ),
+        });
+    }
     let per_stress = membrane_tension_n(scene, 1.0);
     let mut out = scene.clone();
     out.name = format!("{}-at-{}m", scene.name, aperture_m);
@@ -67,7 +86,7 @@ pub fn scaled(scene: &Scene, aperture_m: f64) -> Result<Scene, SizingError> {
     r.focal_length_m *= s;
     r.offset_m *= s;
     out.truss.height_m *= s;
-    out.front_net.rings = ((scene.front_net.rings as f64 * s).round() as usize).max(1);
+    out.front_net.rings = rings as usize;
     // Scaled, not chosen for the scene's surface target.
     out.front_net.chosen = None;
     out.front_net.membrane_stress_n_per_m = Some(scene.front_net.mean_tension_n / per_stress);
@@ -77,8 +96,50 @@ pub fn scaled(scene: &Scene, aperture_m: f64) -> Result<Scene, SizingError> {
     out.rear_net.mean_tension_n = 0.0;
     out.cables.max_force_density_n_per_m *= s;
     // Through the file format: the tensions resolved from the stresses,
-    // every value validated.
-    Ok(Scene::from_toml(&out.to_toml()?, &out.name)?)
+    // every value validated; a scaled value out of its range is the
+    // aperture's fault, said as such.
+    let text = out.to_toml()?;
+    Scene::from_toml(&text, &out.name).map_err(|e| SizingError::Scene {
+        key: "apertures",
+        reason: format!(
+            "{} m: the scene scaled to this aperture is invalid: {e}",
+            number(aperture_m)
+        ),
+    })
+}
+
+/// `x` for a message: as written when it is of a reader's size, with an
+/// exponent otherwise (`1e-300`, not three hundred zeros).
+fn number(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e7).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// `scene` scaled to each of `apertures_m` ([`scaled`]), in order.
+///
+/// # Errors
+/// No aperture, an aperture given twice, and [`scaled`]'s.
+pub fn scaled_scenes(scene: &Scene, apertures_m: &[f64]) -> Result<Vec<Scene>, SizingError> {
+    if apertures_m.is_empty() {
+        return Err(SizingError::Scene {
+            key: "apertures",
+            reason: "no aperture given".into(),
+        });
+    }
+    // Each aperture once: a repeated one would size and design the same
+    // reflector twice (and write its scene twice).
+    for (k, d) in apertures_m.iter().enumerate() {
+        if apertures_m[..k].contains(d) {
+            return Err(SizingError::Scene {
+                key: "apertures",
+                reason: format!("{} m is given twice", number(*d)),
+            });
+        }
+    }
+    apertures_m.iter().map(|&d| scaled(scene, d)).collect()
 }
 
 /// What the study runs.
@@ -161,27 +222,7 @@ pub fn run_aperture_study(
     settings: &ApertureSettings,
     observe: &mut dyn FnMut(&ApertureResult),
 ) -> Result<Vec<ApertureResult>, SizingError> {
-    if settings.apertures_m.is_empty() {
-        return Err(SizingError::Scene {
-            key: "apertures",
-            reason: "no aperture given".into(),
-        });
-    }
-    // Each aperture once: a repeated one would size and design the same
-    // reflector twice (and write its scene twice).
-    for (k, d) in settings.apertures_m.iter().enumerate() {
-        if settings.apertures_m[..k].contains(d) {
-            return Err(SizingError::Scene {
-                key: "apertures",
-                reason: format!("{d} m is given twice"),
-            });
-        }
-    }
-    let scenes = settings
-        .apertures_m
-        .iter()
-        .map(|&d| scaled(scene, d))
-        .collect::<Result<Vec<_>, _>>()?;
+    let scenes = scaled_scenes(scene, &settings.apertures_m)?;
     // The first guess of a tube: the scene's, grown as `s^¾` — a strut's
     // buckling load `∝ EI/L² ∝ D⁴/s²` against a pull `∝ s`.
     let mut guess = (

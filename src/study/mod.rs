@@ -48,7 +48,8 @@ mod plan;
 mod row;
 
 pub use aperture::{
-    run_aperture_study, scaled, ApertureResult, ApertureSettings, ModelResult, MAX_APERTURE_M,
+    run_aperture_study, scaled, scaled_scenes, ApertureResult, ApertureSettings, ModelResult,
+    MAX_APERTURE_M,
 };
 pub use measure::run_study;
 pub use pareto::pareto_optimal;
