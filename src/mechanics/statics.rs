@@ -9,9 +9,9 @@
 
 use super::arc_length;
 use super::assembly::{Factor, State, System};
-use super::model::Model;
 use super::load_control;
 use super::model::MechanicsError;
+use super::model::Model;
 use super::settings::{PathControl, StaticSettings, StaticSolution};
 use super::solver::StaticSolver;
 use super::stability::{self, Stability};

@@ -38,9 +38,8 @@ impl Perturbation {
     /// # Errors
     /// [`VerifyError::Perturbation`] naming the field.
     pub fn check(&self, cables: usize, rods: usize, hinges: usize) -> Result<(), VerifyError> {
-        let bad = |field: &'static str, reason: String| {
-            Err(VerifyError::Perturbation { field, reason })
-        };
+        let bad =
+            |field: &'static str, reason: String| Err(VerifyError::Perturbation { field, reason });
         let factors = |field: &'static str, v: &Option<Vec<f64>>, n: usize| match v {
             Some(v) if v.len() != n => bad(field, format!("{} values for {n} items", v.len())),
             Some(v) if v.iter().any(|f| !(f.is_finite() && *f > 0.0)) => {
@@ -49,7 +48,11 @@ impl Perturbation {
             _ => Ok(()),
         };
         factors("cable_length_factors", &self.cable_length_factors, cables)?;
-        factors("cable_stiffness_factors", &self.cable_stiffness_factors, cables)?;
+        factors(
+            "cable_stiffness_factors",
+            &self.cable_stiffness_factors,
+            cables,
+        )?;
         let flat = self.rod_stretch.as_ref().map(|v| v.concat());
         match &self.rod_stretch {
             Some(v) if v.len() != rods => {
@@ -58,9 +61,10 @@ impl Perturbation {
             _ => factors("rod_stretch", &flat, 2 * rods)?,
         }
         match &self.hinge_offsets_m {
-            Some(v) if v.len() != hinges => {
-                bad("hinge_offsets_m", format!("{} values for {hinges} hinges", v.len()))
-            }
+            Some(v) if v.len() != hinges => bad(
+                "hinge_offsets_m",
+                format!("{} values for {hinges} hinges", v.len()),
+            ),
             Some(v) if v.iter().flatten().any(|c| !c.is_finite()) => {
                 bad("hinge_offsets_m", "an offset is not finite".into())
             }
