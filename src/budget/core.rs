@@ -175,7 +175,11 @@ impl<'a> PerturbedAssembly<'a> {
         self.measure_points(&points, built)
     }
 
-    fn measure_points(&self, points: &[[f64; 3]], built: &Verification) -> Result<Measured, BudgetError> {
+    fn measure_points(
+        &self,
+        points: &[[f64; 3]],
+        built: &Verification,
+    ) -> Result<Measured, BudgetError> {
         let paraboloid = &self.mesh.paraboloid;
         let raw = node_rms(paraboloid, points)?;
         let fit = best_fit_nodes(paraboloid, points)?;

@@ -43,8 +43,8 @@ use serde::Serialize;
 
 use crate::design::{self, DesignError, DesignSettings};
 use crate::effects::ThermalExpansion;
-use crate::shard::Shard;
 use crate::scene::Scene;
+use crate::shard::Shard;
 use crate::surface::{best_fit_facets, facet_rms, SurfaceError};
 use crate::verify::VerifyError;
 
@@ -115,9 +115,7 @@ impl BudgetSettings {
                 None => 0,
                 Some(t) => samples.or(t.samples).unwrap_or(DEFAULT_SAMPLES),
             },
-            seed: seed
-                .or(t.and_then(|t| t.seed))
-                .unwrap_or(DEFAULT_SEED),
+            seed: seed.or(t.and_then(|t| t.seed)).unwrap_or(DEFAULT_SEED),
         }
     }
 }
@@ -199,17 +197,17 @@ pub fn run(
 
     let thermal = ThermalExpansion::of(scene);
     let cases = thermal.as_ref().map_or(&[][..], |t| t.cases());
-    let tolerances = scene.tolerances.as_ref().map(|t| {
-        ToleranceModel::new(t, &run.mesh, &run.network, &run.report.net, &scene.cables)
-    });
+    let tolerances = scene
+        .tolerances
+        .as_ref()
+        .map(|t| ToleranceModel::new(t, &run.mesh, &run.network, &run.report.net, &scene.cables));
     let points = point_count(scene, settings);
     let mine = shard.points(points);
     let first_sample = 2 + cases.len();
     let mesh = &run.mesh;
     let row_of = |k: usize| -> Result<BudgetRow, BudgetError> {
-        let measured = |r: Result<_, BudgetError>| {
-            r.and_then(|v| core.change(&v)).map_err(|e| e.to_string())
-        };
+        let measured =
+            |r: Result<_, BudgetError>| r.and_then(|v| core.change(&v)).map_err(|e| e.to_string());
         let row = if k == 0 {
             let nodes = &mesh.network.nodes[..mesh.n_front_nodes];
             let raw = facet_rms(&mesh.paraboloid, nodes, &mesh.front_triangles)?;
@@ -249,7 +247,11 @@ pub fn run(
             } else {
                 let s = k - first_sample;
                 let model = tolerances.as_ref().expect("samples come from tolerances");
-                (PointKind::Sample, format!("sample {s}"), model.sample(settings.seed, s))
+                (
+                    PointKind::Sample,
+                    format!("sample {s}"),
+                    model.sample(settings.seed, s),
+                )
             };
             BudgetRow {
                 kind,

@@ -281,7 +281,10 @@ impl BudgetTable {
             linear_total[0] += l.raw_mm.powi(2);
             linear_total[1] += l.best_fit_mm.powi(2);
         };
-        for r in rows.iter().filter(|r| matches!(r.kind, PointKind::Facets | PointKind::Design)) {
+        for r in rows
+            .iter()
+            .filter(|r| matches!(r.kind, PointKind::Facets | PointKind::Design))
+        {
             if let Ok(m) = &r.nonlinear {
                 let name = match r.kind {
                     PointKind::Facets => "facets".to_string(),
@@ -318,14 +321,27 @@ impl BudgetTable {
         let failed_samples = rows
             .iter()
             .filter(|r| r.kind == PointKind::Sample)
-            .filter_map(|r| r.nonlinear.as_ref().err().map(|e| format!("{}: {e}", r.name)))
+            .filter_map(|r| {
+                r.nonlinear
+                    .as_ref()
+                    .err()
+                    .map(|e| format!("{}: {e}", r.name))
+            })
             .collect();
         if !samples.is_empty() {
-            let column = |f: &dyn Fn(&Measured) -> f64| samples.iter().map(|(m, _)| f(m)).collect::<Vec<_>>();
-            let linear_column = |f: &dyn Fn(&Measured) -> f64| {
-                samples.iter().filter_map(|(_, l)| l.map(f)).collect::<Vec<_>>()
+            let column = |f: &dyn Fn(&Measured) -> f64| {
+                samples.iter().map(|(m, _)| f(m)).collect::<Vec<_>>()
             };
-            let slack = samples.iter().filter(|(m, _)| !m.slack_cables.is_empty()).count();
+            let linear_column = |f: &dyn Fn(&Measured) -> f64| {
+                samples
+                    .iter()
+                    .filter_map(|(_, l)| l.map(f))
+                    .collect::<Vec<_>>()
+            };
+            let slack = samples
+                .iter()
+                .filter(|(m, _)| !m.slack_cables.is_empty())
+                .count();
             for (name, stat) in [
                 ("tolerances (rms)", rms as fn(&[f64]) -> f64),
                 ("tolerances (p95)", p95 as fn(&[f64]) -> f64),
