@@ -295,3 +295,146 @@ fn monte_carlo_and_linearised_agree_at_small_sigma_and_part_at_large() {
         "no gap at large σ: {large:e} against {small:e}"
     );
 }
+
+/// small-hex with thermal cases (one of which slackens cables: aramid-like
+/// cables 100 K colder shrink by 5e-4 more than the tubes, beyond their
+/// 7e-5 prestrain), tolerances and a frequency, written into `dir`.
+fn budget_scene(dir: &std::path::Path, extra: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(common::problem("small-hex.toml")).unwrap();
+    let text = text.replace("name = \"small-hex\"", "name = \"small-hex-budget\"")
+        + r#"
+[surface]
+frequency_ghz = 8.0
+
+[tolerances]
+cable_length_sigma_m = 5e-6
+tie_length_sigma_m = 5e-6
+rod_length_sigma_m = 2e-5
+cable_stiffness_sigma = 0.02
+hinge_position_sigma_m = 2e-5
+samples = 7
+seed = 3
+
+[effects.thermal]
+cable_expansion_per_k = -4e-6
+tube_expansion_per_k = 1e-6
+
+[[effects.thermal.cases]]
+name = "cold soak"
+uniform_k = -100.0
+
+[[effects.thermal.cases]]
+name = "sun on front"
+front_k = 30.0
+rear_k = -30.0
+"# + extra;
+    let path = dir.join("small-hex-budget.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn succeed(args: &[&str]) -> String {
+    let run = common::ringmesh(args);
+    assert!(
+        run.status.success(),
+        "ringmesh {args:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    String::from_utf8_lossy(&run.stdout).into_owned()
+}
+
+#[test]
+fn sharded_and_merged_budget_equals_the_unsharded_one_bit_for_bit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = budget_scene(tmp.path(), "");
+    let scene = scene.to_str().unwrap();
+    let (whole, shards, merged) = (
+        tmp.path().join("whole"),
+        tmp.path().join("shards"),
+        tmp.path().join("merged"),
+    );
+    let printed = succeed(&["budget", scene, "-o", whole.to_str().unwrap()]);
+    for i in 0..3 {
+        let shard = format!("{i}/3");
+        succeed(&[
+            "budget",
+            scene,
+            "--shard",
+            &shard,
+            "-o",
+            shards.to_str().unwrap(),
+        ]);
+    }
+    succeed(&[
+        "merge",
+        shards.to_str().unwrap(),
+        "-o",
+        merged.to_str().unwrap(),
+    ]);
+    for file in ["budget.csv", "budget.json", "budget-samples.csv"] {
+        let a = std::fs::read(whole.join(file)).unwrap();
+        let b = std::fs::read(merged.join(file)).unwrap();
+        assert!(
+            a == b,
+            "{file} differs between the unsharded and the merged run"
+        );
+    }
+    // 2 + 2 cases + 7 samples points, every sample measured.
+    let samples = std::fs::read_to_string(whole.join("budget-samples.csv")).unwrap();
+    assert_eq!(samples.lines().count(), 1 + 11);
+    // The cold soak slackens cables: the table, the JSON and the printout
+    // name them, and the row counts them.
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(whole.join("budget.json")).unwrap()).unwrap();
+    let slack = &json["table"]["thermal_slack_cables"];
+    let cold = slack
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c[0] == "cold soak")
+        .expect("the cold soak listed");
+    let cables = cold[1].as_array().unwrap();
+    assert!(!cables.is_empty(), "the cold soak slackens no cable");
+    assert!(
+        printed.contains(&format!(
+            "thermal case cold soak: {} cables slack: ",
+            cables.len()
+        )),
+        "{printed}"
+    );
+    let row = samples
+        .lines()
+        .find(|l| l.starts_with("thermal,cold soak,"))
+        .unwrap();
+    let cells: Vec<&str> = row.split(',').collect();
+    assert_eq!(cells[7], cables.len().to_string());
+    assert_eq!(cells[8].split(' ').count(), cables.len());
+}
+
+#[test]
+fn a_bad_tolerance_is_refused_naming_its_key() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(budget_scene(tmp.path(), "")).unwrap();
+    let bad = tmp.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        text.replace(
+            "cable_stiffness_sigma = 0.02",
+            "cable_stiffness_sigma = 0.5",
+        ),
+    )
+    .unwrap();
+    let run = common::ringmesh(&[
+        "budget",
+        bad.to_str().unwrap(),
+        "-o",
+        tmp.path().join("out").to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("tolerances.cable_stiffness_sigma"),
+        "{stderr}"
+    );
+    assert!(!tmp.path().join("out").join("budget.csv").exists());
+}
