@@ -213,8 +213,7 @@ pub(crate) fn write_budget(
         .lines()
         .skip(1)
         .map(BudgetRow::parse)
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(budget::BudgetError::from)?;
+        .collect::<Result<Vec<_>, _>>()?;
     let table = BudgetTable::of(&rows, frequency_ghz);
     let samples: Vec<(f64, f64)> = rows
         .iter()
