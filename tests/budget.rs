@@ -438,3 +438,26 @@ fn a_bad_tolerance_is_refused_naming_its_key() {
     );
     assert!(!tmp.path().join("out").join("budget.csv").exists());
 }
+
+/// Thermal cases and tolerances cost a design nothing: the design of a
+/// scene that has them builds no thermal effect and is the design of the
+/// scene without them.
+#[test]
+fn a_design_ignores_the_budget_sections() {
+    use ringmesh::effects::{self, EffectKind};
+    let tmp = tempfile::tempdir().unwrap();
+    let with = Scene::read(&budget_scene(tmp.path(), "")).expect("valid");
+    let (plain, plain_run) = designed();
+    assert!(plain.effects.thermal.is_none() && plain.tolerances.is_none());
+    effects::reset_log();
+    let run = design::run(&with, &DesignSettings::default(), &mut |_, _| {}).expect("designs");
+    assert_eq!(
+        effects::constructed().get(&EffectKind::ThermalExpansion),
+        None
+    );
+    assert_eq!(run.report.net.tensions_n, plain_run.report.net.tensions_n);
+    assert_eq!(
+        run.report.verification.rms_mm,
+        plain_run.report.verification.rms_mm
+    );
+}

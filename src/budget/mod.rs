@@ -134,7 +134,8 @@ pub struct BudgetTimings {
     /// Each sample's nonlinear assembly, mean (wall time of all over their
     /// number: the samples run in parallel).
     pub sample_s: Option<f64>,
-    /// Each linearised point (case or sample), mean.
+    /// Each linearised point (case or sample: one residual, one solve, the
+    /// surface measured), mean.
     pub linear_point_s: Option<f64>,
 }
 
@@ -205,6 +206,8 @@ pub fn run(
     let mine = shard.points(points);
     let first_sample = 2 + cases.len();
     let mesh = &run.mesh;
+    // Time of the linearised points (solve and measurement), and their count.
+    let linear_time = std::sync::Mutex::new((0.0f64, 0usize));
     let row_of = |k: usize| -> Result<BudgetRow, BudgetError> {
         let measured =
             |r: Result<_, BudgetError>| r.and_then(|v| core.change(&v)).map_err(|e| e.to_string());
@@ -253,11 +256,17 @@ pub fn run(
                     model.sample(settings.seed, s),
                 )
             };
+            let nonlinear = measured(core.nonlinear(&p));
+            let clock = Instant::now();
+            let linear = Some(measured(core.linear(&tangent, &p)));
+            let mut spent = linear_time.lock().unwrap_or_else(|e| e.into_inner());
+            spent.0 += clock.elapsed().as_secs_f64();
+            spent.1 += 1;
             BudgetRow {
                 kind,
                 name,
-                nonlinear: measured(core.nonlinear(&p)),
-                linear: Some(measured(core.linear(&tangent, &p))),
+                nonlinear,
+                linear,
             }
         };
         observe(&row);
@@ -282,6 +291,10 @@ pub fn run(
         timings.sample_s = Some(clock.elapsed().as_secs_f64() / sampled.len() as f64);
     }
     rows.extend(sampled_rows);
+    let (spent, count) = *linear_time.lock().unwrap_or_else(|e| e.into_inner());
+    if count > 0 {
+        timings.linear_point_s = Some(spent / count as f64);
+    }
     Ok(BudgetRun {
         rows,
         points,

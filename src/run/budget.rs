@@ -64,6 +64,9 @@ impl BudgetOutcome {
         if let Some(c) = t.sample_s {
             times += &format!(", per sample {} s (parallel)", readable(c, 3));
         }
+        if let Some(c) = t.linear_point_s {
+            times += &format!(", per linearised point {} s", readable(c, 3));
+        }
         say!(s, "time: {times}");
         s.written(&self.written);
         s
