@@ -221,6 +221,10 @@ pub struct BudgetTable {
     pub samples: usize,
     /// Samples whose nonlinear assembly failed, with why.
     pub failed_samples: Vec<String>,
+    /// Thermal cases whose nonlinear assembly failed, with why (their
+    /// linearised estimate is in `budget-samples.csv`; the total leaves
+    /// them out, and says so here).
+    pub failed_cases: Vec<String>,
     /// The thermal case with the largest best-fit RMS, the one the total
     /// counts (cases are alternatives: the orbit is in one at a time).
     pub worst_thermal_case: Option<String>,
@@ -318,6 +322,11 @@ impl BudgetTable {
             .filter(|r| r.kind == PointKind::Sample)
             .filter_map(|r| r.nonlinear.as_ref().ok().map(|m| (m, linear_of(r))))
             .collect();
+        let failed_cases = rows
+            .iter()
+            .filter(|r| r.kind == PointKind::Thermal)
+            .filter_map(|r| r.nonlinear.as_ref().err().map(|e| format!("{}: {e}", r.name)))
+            .collect();
         let failed_samples = rows
             .iter()
             .filter(|r| r.kind == PointKind::Sample)
@@ -380,6 +389,7 @@ impl BudgetTable {
             terms,
             samples: samples.len(),
             failed_samples,
+            failed_cases,
             worst_thermal_case: worst.map(|(r, _)| r.name.clone()),
             thermal_slack_cables,
             frequency_ghz,

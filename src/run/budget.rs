@@ -115,6 +115,9 @@ fn table_lines(s: &mut Summary, table: &BudgetTable) {
             readable((2.0 / table.samples as f64).sqrt(), 2)
         );
     }
+    for f in &table.failed_cases {
+        say!(s, "thermal case failed (left out of the total): {f}");
+    }
     for f in &table.failed_samples {
         say!(s, "failed: {f}");
     }
