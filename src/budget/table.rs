@@ -325,7 +325,12 @@ impl BudgetTable {
         let failed_cases = rows
             .iter()
             .filter(|r| r.kind == PointKind::Thermal)
-            .filter_map(|r| r.nonlinear.as_ref().err().map(|e| format!("{}: {e}", r.name)))
+            .filter_map(|r| {
+                r.nonlinear
+                    .as_ref()
+                    .err()
+                    .map(|e| format!("{}: {e}", r.name))
+            })
             .collect();
         let failed_samples = rows
             .iter()
