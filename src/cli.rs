@@ -321,12 +321,44 @@ pub enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
-    /// Join the shards of `front` or `study` runs into one table and plot.
+    /// The error budget of a dish as built on the flexible truss: facets,
+    /// design, each thermal case, manufacturing tolerances, their
+    /// root-sum-square and the gain loss at the scene's frequency.
+    ///
+    /// The scene's `[effects.thermal]` (expansion coefficients, named load
+    /// cases) and `[tolerances]` (standard deviations of cut lengths, rod
+    /// lengths, EA, hinge positions) say what to budget. Each case and each
+    /// Monte Carlo sample is assembled from the design's equilibrium by
+    /// Newton and, on the same draws, through its tangent (linearised).
+    /// Writes budget.csv, budget.json, budget-samples.csv (every point),
+    /// budget.png and budget.svg; with --shard, budget-samples.shard-I-of-N.csv
+    /// for `ringmesh merge`.
+    ///
+    /// Example: ringmesh budget problems/small-hex.toml --samples 100 --seed 1
+    Budget {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// Monte Carlo samples [default: the scene's `[tolerances] samples`, else 100].
+        #[arg(long)]
+        samples: Option<usize>,
+        /// Seed of the samples [default: the scene's `[tolerances] seed`, else 1].
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Run only shard I of N (from 0: point k runs when k mod N = I) and
+        /// write budget-samples.shard-I-of-N.csv; join the shards with
+        /// `ringmesh merge`.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<Shard>,
+        /// Output folder [default: results/<scene name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Join the shards of `front`, `study` or `budget` runs into one table and plot.
     ///
     /// Takes shard files or folders holding *.shard-I-of-N.csv; each command's
     /// shards must be all of 0..N of one sweep of one scene with the same
-    /// settings, else nothing is written. Writes front.csv/.png/.svg or
-    /// accuracy-vs-time.csv/.png/.svg.
+    /// settings, else nothing is written. Writes front.csv/.png/.svg,
+    /// accuracy-vs-time.csv/.png/.svg or the budget's files.
     ///
     /// Example: ringmesh merge results/realistic-26m
     Merge {

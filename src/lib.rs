@@ -40,6 +40,7 @@
 #![warn(missing_docs)]
 
 pub mod algebra;
+pub mod budget;
 pub mod design;
 pub mod effects;
 pub mod fdm;
@@ -111,6 +112,9 @@ pub enum Error {
     /// A surface that cannot be measured, or a net target no net meets.
     #[error(transparent)]
     Surface(#[from] surface::SurfaceError),
+    /// An error budget that cannot be made.
+    #[error(transparent)]
+    Budget(#[from] budget::BudgetError),
 }
 
 impl From<truss::SceneResponseError> for Error {
@@ -140,6 +144,7 @@ impl Error {
             Error::Sizing(e) => e.is_bad_input(),
             Error::Surface(e) => e.is_bad_input(),
             Error::Verify(e) => e.is_bad_input(),
+            Error::Budget(e) => e.is_bad_input(),
         }
     }
 }

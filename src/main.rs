@@ -197,6 +197,18 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
             progress.0.finish_and_clear();
             result?.summary()
         }
+        Command::Budget {
+            scene,
+            samples,
+            seed,
+            shard,
+            output,
+        } => {
+            let progress = bar();
+            let result = run::budget(scene, *samples, *seed, output.as_deref(), *shard, &progress);
+            progress.0.finish_and_clear();
+            result?.summary()
+        }
         Command::Study {
             scene,
             knobs,

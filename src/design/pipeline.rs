@@ -21,7 +21,7 @@ use crate::network::Network;
 use crate::scene::{Scene, TrussModel};
 use crate::status::Termination;
 use crate::surface::{budget, resolve_front_rings, FrontSurface, SurfaceBudget};
-use crate::truss::{RingTruss, RingTrussBuilder, TrussError};
+use crate::truss::{RingTruss, RingTrussBuilder, TrussEquilibrium, TrussError};
 use crate::uniformity::{Design, SolverKind, UniformitySet};
 use crate::verify::{verify_on_frame, Verification};
 
@@ -220,6 +220,13 @@ pub struct DesignRun {
     pub conventional_net: Option<Design>,
     /// The uniformity sets the design makes uniform (cables of `network`).
     pub sets: Vec<UniformitySet>,
+    /// The flexible truss's equilibrium under the design's pull (the loop's
+    /// last; absent for a rigid truss): what an assembly of the design
+    /// starts from.
+    pub truss_equilibrium: Option<TrussEquilibrium>,
+    /// The conventional design's network and its truss equilibrium (the
+    /// loop's iteration 0), when the truss deforms.
+    pub conventional_start: Option<(Network, Option<TrussEquilibrium>)>,
 }
 
 /// The outer design loop (net design ⇄ truss response) of `scene` with each
@@ -365,6 +372,12 @@ pub fn run(
     // undeformed attachment points, assembled from the truss's response to
     // it that the loop already solved.
     let conventional_net = frame.map(|_| outcome.initial.design.clone());
+    let conventional_start = frame.map(|_| {
+        (
+            outcome.initial.problem.network().clone(),
+            outcome.initial_truss_equilibrium.clone(),
+        )
+    });
     let conventional = match frame {
         None => None,
         Some(frame) => Some(verify_on_frame(
@@ -405,6 +418,8 @@ pub fn run(
         network,
         conventional_net,
         sets,
+        truss_equilibrium: outcome.truss_equilibrium,
+        conventional_start,
     })
 }
 

@@ -18,6 +18,7 @@
 //! | [`Gravity`] | `[effects.gravity]` | the nets' nodal loads (the cables' weight) and the truss's dead loads (rods and hinges) |
 //! | [`MeasuredRods`] | `[effects] rod_properties_csv` | the sections of the rods the table names |
 //! | [`InextensibleCables`] | `[effects] cable_elasticity = false` | the verification's cables |
+//! | [`ThermalExpansion`] | `[effects.thermal]` | the error budget's load cases only (`crate::budget` builds it; the design is made at the build temperature) |
 //!
 //! Every construction is logged per thread ([`constructed`]; every
 //! construction of one run happens on the thread that runs it), so that a
@@ -27,6 +28,7 @@
 mod cable_elasticity;
 mod gravity;
 mod measured_rods;
+mod thermal;
 
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -38,6 +40,7 @@ use serde::Serialize;
 pub use cable_elasticity::{CableModel, InextensibleCables, INEXTENSIBLE_STIFFENING};
 pub use gravity::{CableSelfWeight, Gravity};
 pub use measured_rods::MeasuredRods;
+pub use thermal::{Side, ThermalExpansion};
 
 use crate::mechanics::{ModelBuilder, NodalLoad, NodeId, Rod, Section};
 use crate::scene::{Scene, TrussRod};
@@ -179,6 +182,8 @@ pub enum EffectKind {
     RodProperties,
     /// Inextensible cables in a verification (`cable_elasticity = false`).
     InextensibleCables,
+    /// Thermal load cases of an error budget (`[effects.thermal]`).
+    ThermalExpansion,
 }
 
 thread_local! {

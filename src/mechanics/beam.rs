@@ -334,6 +334,27 @@ impl BeamElement {
         (g, h)
     }
 
+    /// The element with a free stretch: its stress-free state the reference
+    /// geometry scaled by `length_factor` (`L → sL`, `K₀ → K₀/s`, `Γ₀`
+    /// unchanged: the scaled helix), its section scaled by `section_factor`
+    /// in every dimension (`EA, GA × f²`, `GJ, EI × f⁴`). A free thermal
+    /// strain `αΔT` is `s = f = 1 + αΔT` — with one `s` everywhere, the
+    /// scaled frame carries the same stresses, so an unloaded structure
+    /// simply scales; a rod cut long by `δ` is `s = 1 + δ/L`, `f = 1`.
+    pub fn stretched(&self, length_factor: f64, section_factor: f64) -> Self {
+        let (s, f2) = (length_factor, section_factor * section_factor);
+        let mut e = self.clone();
+        e.length_m *= s;
+        for k in 3..6 {
+            e.reference_strain[k] /= s;
+        }
+        for k in 0..3 {
+            e.stiffness[k] *= f2;
+            e.stiffness[3 + k] *= f2 * f2;
+        }
+        e
+    }
+
     /// Axial stiffness over length, `EA/L`, N/m.
     pub fn axial_stiffness(&self) -> f64 {
         self.stiffness[0] / self.length_m

@@ -71,3 +71,4 @@ pub use path_spec::{CriticalKind, CriticalPoint, PathPoint, PathSolution, PathSp
 pub use settings::{PathControl, StaticSettings, StaticSolution, StaticTermination, StepRecord};
 pub use solver::StaticSolver;
 pub use stability::{Mode, Stability};
+pub use statics::Linearisation;

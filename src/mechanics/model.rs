@@ -484,6 +484,53 @@ impl ModelBuilder {
         });
     }
 
+    /// A free stretch of every rod, in the order they were added:
+    /// `factors[r] = [length, section]`, each element of rod `r` made
+    /// [`BeamElement::stretched`] (its stress-free length × `length`, its
+    /// section's dimensions × `section`). The structure stays: the same
+    /// nodes, elements and joints.
+    ///
+    /// # Panics
+    /// If `factors` does not hold one pair per rod.
+    #[track_caller]
+    pub fn stretch_rods(&mut self, factors: &[[f64; 2]]) {
+        assert_eq!(factors.len(), self.rods.len(), "one stretch per rod");
+        // Elements are meshed rod by rod: rod r's are the next
+        // `nodes − 1` of the list.
+        let mut first = 0;
+        for (rod, &[length, section]) in self.rods.iter().zip(factors) {
+            let n = rod.nodes.len().saturating_sub(1);
+            for e in &mut self.elements[first..first + n] {
+                *e = e.stretched(length, section);
+            }
+            first += n;
+        }
+    }
+
+    /// Move node `node`'s reference position by `by_m`, the joints on it
+    /// staying where they were added: a rigid body (a hinge) built off its
+    /// place by `by_m`, what it carries (cables on its position) moved with
+    /// it.
+    pub fn displace_node(&mut self, node: NodeId, by_m: Vector3<f64>) {
+        match self.reference.get_mut(node) {
+            Some(f) if by_m.iter().all(|c| c.is_finite()) => f.position_m += by_m,
+            _ => self.errors.push(MechanicsError::invalid(
+                format!("node {node}"),
+                "a displacement of a missing node, or not finite",
+            )),
+        }
+    }
+
+    /// Nodes added so far.
+    pub fn node_count(&self) -> usize {
+        self.reference.len()
+    }
+
+    /// Rods added so far.
+    pub fn rod_count(&self) -> usize {
+        self.rods.len()
+    }
+
     /// The reference configuration of a node added so far.
     pub fn frame(&self, node: NodeId) -> Option<&Frame> {
         self.reference.get(node)

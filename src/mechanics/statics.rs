@@ -8,9 +8,10 @@
 //! silently wrong state.
 
 use super::arc_length;
-use super::assembly::{State, System};
+use super::assembly::{Factor, State, System};
 use super::load_control;
 use super::model::MechanicsError;
+use super::model::Model;
 use super::settings::{PathControl, StaticSettings, StaticSolution};
 use super::solver::StaticSolver;
 use super::stability::{self, Stability};
@@ -82,6 +83,28 @@ impl StaticSolver {
         Ok(state)
     }
 
+    /// The first-order response of the equilibrium `state` (at load factor
+    /// `lambda`) to changes of the model: its tangent factored once, one
+    /// solve per change ([`Linearisation::respond`]).
+    ///
+    /// # Errors
+    /// A tangent that cannot be factored (a mechanism).
+    pub fn linearise(
+        &self,
+        state: &State,
+        lambda: f64,
+    ) -> Result<Linearisation<'_>, MechanicsError> {
+        let ev = self.system().evaluate(self.model(), state, lambda);
+        let factor = self.system().factor(&ev.values)?;
+        Ok(Linearisation {
+            solver: self,
+            state: state.clone(),
+            lambda,
+            residual: ev.residual,
+            factor,
+        })
+    }
+
     /// The stability of `state`, an equilibrium at load factor `lambda`: is
     /// the stiffness positive definite on the joints' constraints (inverse
     /// iteration with the tangent's factor)?
@@ -90,5 +113,61 @@ impl StaticSolver {
     /// A tangent that cannot be factored (a mechanism, or exactly critical).
     pub fn stability(&self, state: &State, lambda: f64) -> Result<Stability, MechanicsError> {
         stability::stability(self, state, lambda)
+    }
+}
+
+/// An equilibrium's tangent, factored: the first-order response of the
+/// equilibrium to a change of its model's parameters
+/// ([`StaticSolver::linearise`]).
+pub struct Linearisation<'a> {
+    solver: &'a StaticSolver,
+    state: State,
+    lambda: f64,
+    /// The residual of the equilibrium (its roundoff), subtracted so that an
+    /// unchanged model responds by exactly nothing.
+    residual: Vec<f64>,
+    factor: Factor,
+}
+
+impl Linearisation<'_> {
+    /// The equilibrium to first order of `changed`, a model of the same
+    /// structure (nodes, supports, elements, cables and joints, in the same
+    /// order: only their parameters differ): `x* + δ` with
+    /// `J δ = −(R_changed(x*) − R(x*))`, `J` the tangent at `x*`.
+    ///
+    /// # Errors
+    /// A model of another structure, or a non-finite response.
+    pub fn respond(&self, changed: &Model) -> Result<State, MechanicsError> {
+        let model = self.solver.model();
+        if changed.node_count() != model.node_count()
+            || changed.elements.len() != model.elements.len()
+            || changed.cables.len() != model.cables.len()
+            || changed.joints.len() != model.joints.len()
+            || changed.fixed != model.fixed
+        {
+            return Err(MechanicsError::invalid(
+                "linearised response",
+                "the changed model has another structure than the linearised one",
+            ));
+        }
+        let system = self.solver.system();
+        let ev = system.evaluate(changed, &self.state, self.lambda);
+        let change: Vec<f64> = ev
+            .residual
+            .iter()
+            .zip(&self.residual)
+            .map(|(r, r0)| r - r0)
+            .collect();
+        let mut rhs = system.column(&change);
+        System::solve_in_place(&self.factor, rhs.as_mut());
+        let delta: Vec<f64> = (0..system.n_rows).map(|i| -rhs[(i, 0)]).collect();
+        if !delta.iter().all(|d| d.is_finite()) {
+            return Err(MechanicsError::NotFinite {
+                detail: "the linearised response is not finite".into(),
+            });
+        }
+        let mut state = self.state.clone();
+        system.apply(&mut state, &delta, 1.0);
+        Ok(state)
     }
 }

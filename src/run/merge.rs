@@ -1,8 +1,9 @@
-//! `ringmesh merge`: shards of `front` and `study` joined into the tables and
-//! plots of the unsharded runs.
+//! `ringmesh merge`: shards of `front`, `study` and `budget` joined into the
+//! tables and plots of the unsharded runs.
 
 use std::path::{Path, PathBuf};
 
+use super::budget::{self, write_budget};
 use super::front::{self, write_front};
 use super::study::{self, write_study};
 use super::Summary;
@@ -69,6 +70,8 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<MergeOutcom
     enum Table {
         Front(Vec<FrontRow>),
         Study(Vec<StudyRow>),
+        /// The budget's table is computed from the merged text.
+        Budget,
     }
     let mut tables = Vec::new();
     for m in &merged {
@@ -92,6 +95,12 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<MergeOutcom
                     .map(|(r, l)| parse_study_row(l).map_err(|e| bad(r, e.to_string())))
                     .collect::<Result<_, _>>()?,
             ),
+            "budget" => {
+                for (r, l) in m.rows.iter().enumerate() {
+                    crate::budget::BudgetRow::parse(l).map_err(|e| bad(r, e.to_string()))?;
+                }
+                Table::Budget
+            }
             other => return Err(bad(0, format!("unknown command `{other}`")).into()),
         };
         tables.push(table);
@@ -118,6 +127,18 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<MergeOutcom
             Table::Study(rows) => {
                 let set = OutputSet::begin(&dir, &study::FILES)?;
                 write_study(set, &m.header.scene, &rows, &StudyRms::Design, &m.csv())?
+            }
+            Table::Budget => {
+                let set = OutputSet::begin(&dir, &budget::FILES)?;
+                let frequency_ghz = m.header.scene_file["surface"]["frequency_ghz"].as_f64();
+                write_budget(
+                    set,
+                    &m.header.scene,
+                    &m.header.settings,
+                    frequency_ghz,
+                    &m.csv(),
+                )?
+                .1
             }
         };
         outcomes.push(MergedTable {

@@ -14,6 +14,7 @@ macro_rules! say {
 }
 
 mod apertures;
+mod budget;
 mod cantilever;
 mod design;
 mod fdm;
@@ -30,6 +31,7 @@ mod uniformity;
 use std::path::{Path, PathBuf};
 
 pub use apertures::{aperture_line, apertures, AperturesOutcome};
+pub use budget::{budget, BudgetOutcome};
 pub use cantilever::{cantilever, CantileverTable, CantileverTableRow};
 pub use design::{design, iteration_line, DesignOutcome};
 pub use fdm::{fdm, FdmOutcome, FdmOutput};

@@ -37,7 +37,8 @@ pub use error::SceneError;
 pub use rod_properties::{RodKind, RodProperties, RodPropertiesError, RodStiffness, TrussRod};
 pub use schema::{
     membrane_tension_n, Cables, ChosenRings, Effects, FrontNet, Gravity, RearNet, Reflector, Scene,
-    Supports, SurfaceSpec, Truss, TrussModel, UniformNet, Uniformity,
+    Supports, SurfaceSpec, Thermal, ThermalCase, Tolerances, Truss, TrussModel, UniformNet,
+    Uniformity,
 };
 pub use validate::{
     modulus_range, MAX_BAYS, MAX_ELEMENTS_PER_ROD, MAX_HEIGHT_RATIO, MAX_MODULUS_PA, MAX_NAME_LEN,

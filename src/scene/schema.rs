@@ -34,6 +34,100 @@ pub struct Scene {
     /// The surface accuracy the dish must hold, and its band.
     #[serde(default, skip_serializing_if = "SurfaceSpec::is_empty")]
     pub surface: SurfaceSpec,
+    /// Manufacturing tolerances of the error budget (`ringmesh budget`);
+    /// absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerances: Option<Tolerances>,
+}
+
+/// Manufacturing tolerances (`[tolerances]`): standard deviations of
+/// independent, zero-mean normal errors, each drawn per item.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Tolerances {
+    /// Cut length of each net cable (front, rear, boundaries), m.
+    pub cable_length_sigma_m: f64,
+    /// Cut length of each tie, m.
+    pub tie_length_sigma_m: f64,
+    /// Length of each truss rod (batten, longeron, diagonal tube), m.
+    pub rod_length_sigma_m: f64,
+    /// Axial stiffness EA of each cable, relative (0.02: 2 %).
+    pub cable_stiffness_sigma: f64,
+    /// Position of each hinge (where the nets attach), each component, m.
+    pub hinge_position_sigma_m: f64,
+    /// Monte Carlo samples (`ringmesh budget --samples` overrides).
+    pub samples: Option<usize>,
+    /// Seed of the samples (`--seed` overrides).
+    pub seed: Option<u64>,
+}
+
+impl Tolerances {
+    /// The standard deviations by name, as the scene's keys name them.
+    pub fn sigmas(&self) -> [(&'static str, f64); 5] {
+        [
+            ("tolerances.cable_length_sigma_m", self.cable_length_sigma_m),
+            ("tolerances.tie_length_sigma_m", self.tie_length_sigma_m),
+            ("tolerances.rod_length_sigma_m", self.rod_length_sigma_m),
+            (
+                "tolerances.cable_stiffness_sigma",
+                self.cable_stiffness_sigma,
+            ),
+            (
+                "tolerances.hinge_position_sigma_m",
+                self.hinge_position_sigma_m,
+            ),
+        ]
+    }
+}
+
+/// Thermal distortion in orbit (`[effects.thermal]`): expansion coefficients
+/// per material and named load cases, each a field of temperature change
+/// from the temperature the dish was built at. The hinges are rigid bodies
+/// of the tube material; in this frame every joint sits at its hinge's
+/// position (bodies of no extent), so they have nothing to expand.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Thermal {
+    /// Expansion coefficient of the net cables, 1/K.
+    pub cable_expansion_per_k: f64,
+    /// Of the ties, 1/K (absent: the cables').
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tie_expansion_per_k: Option<f64>,
+    /// Of the truss tubes (and hinge bodies), 1/K.
+    pub tube_expansion_per_k: f64,
+    /// The load cases.
+    pub cases: Vec<ThermalCase>,
+}
+
+/// One thermal load case: the temperature change at a point, the sum of a
+/// uniform part, a linear gradient across the aperture and a front/rear
+/// difference (front net and top longerons at `front_k`, rear net and
+/// bottom longerons at `rear_k`, ties, battens and diagonals at their
+/// mean), each term 0 unless given.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThermalCase {
+    /// The case's name in the budget.
+    pub name: String,
+    /// Uniform temperature change, K.
+    #[serde(default)]
+    pub uniform_k: f64,
+    /// Gradient across the aperture, K/m, zero at the aperture's centre.
+    #[serde(default)]
+    pub gradient_k_per_m: f64,
+    /// Its plan direction `[x, y]` (any length but zero).
+    #[serde(default = "x_direction")]
+    pub gradient_direction: [f64; 2],
+    /// Temperature change of the front side, K.
+    #[serde(default)]
+    pub front_k: f64,
+    /// Temperature change of the rear side, K.
+    #[serde(default)]
+    pub rear_k: f64,
+}
+
+fn x_direction() -> [f64; 2] {
+    [1.0, 0.0]
 }
 
 /// The surface a dish must hold, as its engineer states it (`[surface]`).
@@ -295,6 +389,10 @@ pub struct Effects {
     /// EA of `[cables]`, cut to `L₀ = ℓ/(1 + T/EA)`) or inextensible ones
     /// (`false`; see [`crate::verify::CableModel`]).
     pub cable_elasticity: bool,
+    /// Thermal load cases of the error budget (`ringmesh budget`); absent:
+    /// none. The design itself is made at the build temperature.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<Thermal>,
 }
 
 impl Default for Effects {
@@ -305,6 +403,7 @@ impl Default for Effects {
             rod_properties_csv: None,
             rod_properties: None,
             cable_elasticity: true,
+            thermal: None,
         }
     }
 }

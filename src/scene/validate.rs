@@ -224,8 +224,116 @@ impl Scene {
                 ));
             }
         }
+        if let Some(t) = &self.effects.thermal {
+            thermal(t)?;
+        }
+        if let Some(t) = &self.tolerances {
+            for (key, sigma) in t.sigmas() {
+                non_negative(key, sigma)?;
+            }
+            if t.cable_stiffness_sigma >= MAX_RELATIVE_SIGMA {
+                return Err(SceneError::invalid(
+                    "tolerances.cable_stiffness_sigma",
+                    format!(
+                        "{} must be below {MAX_RELATIVE_SIGMA}: a normal error of that spread \
+                         gives cables of no or negative stiffness",
+                        t.cable_stiffness_sigma
+                    ),
+                ));
+            }
+            if t.samples == Some(0) {
+                return Err(SceneError::invalid(
+                    "tolerances.samples",
+                    "0: a Monte Carlo needs at least one sample",
+                ));
+            }
+        }
         Ok(())
     }
+}
+
+/// Largest relative standard deviation of a stiffness.
+pub const MAX_RELATIVE_SIGMA: f64 = 0.2;
+
+/// Largest free thermal strain `|α ΔT|` a case may ask for: far beyond any
+/// material in orbit (carbon tubes 1e-6/K, aramid cords −4e-6/K, steel
+/// 1.2e-5/K over ±150 K: 2e-3).
+pub const MAX_THERMAL_STRAIN: f64 = 0.01;
+
+/// `[effects.thermal]`: finite coefficients, named cases, fields whose
+/// strain stays small.
+fn thermal(t: &super::schema::Thermal) -> Result<(), SceneError> {
+    let finite = |key: &'static str, v: f64| {
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(SceneError::invalid(
+                key,
+                format!("{v} must be a finite number"),
+            ))
+        }
+    };
+    finite(
+        "effects.thermal.cable_expansion_per_k",
+        t.cable_expansion_per_k,
+    )?;
+    finite(
+        "effects.thermal.tube_expansion_per_k",
+        t.tube_expansion_per_k,
+    )?;
+    if let Some(a) = t.tie_expansion_per_k {
+        finite("effects.thermal.tie_expansion_per_k", a)?;
+    }
+    if t.cases.is_empty() {
+        return Err(SceneError::invalid(
+            "effects.thermal.cases",
+            "no case: give at least one `[[effects.thermal.cases]]`",
+        ));
+    }
+    let alpha = t
+        .cable_expansion_per_k
+        .abs()
+        .max(t.tube_expansion_per_k.abs())
+        .max(t.tie_expansion_per_k.unwrap_or(0.0).abs());
+    for (i, c) in t.cases.iter().enumerate() {
+        let named = |reason: String| {
+            SceneError::invalid(
+                "effects.thermal.cases",
+                format!("case {} ({:?}): {reason}", i + 1, c.name),
+            )
+        };
+        if c.name.trim().is_empty() || c.name.contains(['\n', ',', '"']) {
+            return Err(named(
+                "a case needs a name without commas, quotes or line breaks".into(),
+            ));
+        }
+        if t.cases[..i].iter().any(|o| o.name == c.name) {
+            return Err(named("the name is given twice".into()));
+        }
+        let values = [c.uniform_k, c.gradient_k_per_m, c.front_k, c.rear_k];
+        if values
+            .iter()
+            .chain(&c.gradient_direction)
+            .any(|v| !v.is_finite())
+        {
+            return Err(named("every value must be a finite number".into()));
+        }
+        if c.gradient_k_per_m != 0.0 && c.gradient_direction.iter().all(|&v| v == 0.0) {
+            return Err(named("gradient_direction must not be zero".into()));
+        }
+        // The largest change anywhere: bounded by the terms' sum over a
+        // dish of at most the aperture… the gradient is checked per metre.
+        let most = c.uniform_k.abs() + c.front_k.abs().max(c.rear_k.abs());
+        if alpha * most > MAX_THERMAL_STRAIN
+            || alpha * c.gradient_k_per_m.abs() > MAX_THERMAL_STRAIN
+        {
+            return Err(named(format!(
+                "a free strain |α ΔT| above {MAX_THERMAL_STRAIN} (K or K/m too large for the \
+                 coefficients)"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Exactly one of `<net>.mean_tension_n` and `<net>.membrane_stress_n_per_m`

@@ -43,6 +43,18 @@ pub enum VerifyError {
     /// non-finite position).
     #[error("the surface as built: {0}")]
     Surface(#[from] SurfaceError),
+    /// A perturbation of the wrong size or with invalid values.
+    #[error("perturbation of the assembly: {field}: {reason}")]
+    Perturbation {
+        /// The field at fault.
+        field: &'static str,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A perturbation the assembly cannot take (rods or hinges of a rigid
+    /// truss, inextensible cables).
+    #[error("perturbation of the assembly: {0}")]
+    Unsupported(String),
     /// The assembly found no equilibrium.
     #[error(
         "the assembled net and truss found no equilibrium: the solve {termination} (last \

@@ -15,9 +15,11 @@
 //! says which model an assembly used.
 
 mod error;
+mod perturbation;
 mod stiffening;
 
 pub use error::VerifyError;
+pub use perturbation::Perturbation;
 
 pub use crate::effects::{CableModel, INEXTENSIBLE_STIFFENING};
 
@@ -31,7 +33,9 @@ use crate::algebra::norm3;
 use crate::effects::SceneEffects;
 use crate::geometry::{ReflectorMesh, RingTrussLayout};
 use crate::mechanics::constraint_scale;
-use crate::mechanics::{Model, ModelBuilder, NodeId, StaticSettings, StaticSolver};
+use crate::mechanics::{
+    Frame, Linearisation, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver,
+};
 use crate::network::Network;
 use crate::scene::Scene;
 use crate::surface::node_rms;
@@ -163,10 +167,222 @@ pub fn verify_on_frame(
     frame: Option<&RingTrussBuilder>,
     equilibrium: Option<&TrussEquilibrium>,
 ) -> Result<Verification, VerifyError> {
-    let truss = match frame {
-        Some(_) => AssemblyTruss::Flexible,
-        None => AssemblyTruss::Rigid,
+    let inputs = AssemblyInputs {
+        scene,
+        mesh,
+        effects,
+        network,
+        design,
+        frame,
     };
+    Ok(assemble(&inputs, equilibrium, &Perturbation::none())?.verification)
+}
+
+/// What an assembly is made of: the scene, its mesh and effects, the design
+/// (made on `network`, whose fixed nodes are the attachment points in the
+/// truss's order) and the flexible truss's frame (`None`: the rigid
+/// attachment points).
+#[derive(Debug, Clone, Copy)]
+pub struct AssemblyInputs<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Its nets and truss layout.
+    pub mesh: &'a ReflectorMesh,
+    /// Its effects.
+    pub effects: &'a SceneEffects,
+    /// The network the design is made on.
+    pub network: &'a Network,
+    /// The design.
+    pub design: &'a Design,
+    /// The flexible truss's frame, or `None` for the rigid truss.
+    pub frame: Option<&'a RingTrussBuilder>,
+}
+
+/// An assembled equilibrium: its verification, and what a perturbed
+/// assembly starts from ([`assemble`] with `start`) or is linearised about
+/// ([`Assembled::linearise`]).
+pub struct Assembled {
+    /// The assembly judged against the design.
+    pub verification: Verification,
+    /// The whole assembly's state (truss, net points, multipliers) and
+    /// constraint scale: a start for the same assembly perturbed.
+    pub state: TrussEquilibrium,
+    solver: StaticSolver,
+}
+
+/// The models of one assembly: the truss (perturbed) and the net's points,
+/// with and without the cables.
+struct AssemblyModels {
+    /// Truss, points and cables at their cut lengths.
+    cut: ModelBuilder,
+    /// The same with the cables' unstressed lengths ramped from the
+    /// stress-free distance of their ends.
+    ramped: ModelBuilder,
+    /// The same with the cables ramped from the design's cut lengths to the
+    /// perturbed ones (a warm start's path).
+    from_design: ModelBuilder,
+    /// Truss and points only.
+    bare: ModelBuilder,
+    /// Model node of each net node.
+    node_of: Vec<NodeId>,
+}
+
+impl AssemblyModels {
+    fn new(inputs: &AssemblyInputs<'_>, perturbation: &Perturbation) -> Result<Self, VerifyError> {
+        let AssemblyInputs {
+            scene,
+            mesh,
+            network,
+            design,
+            frame,
+            ..
+        } = *inputs;
+        let layout = &mesh.truss;
+        let hinges: Vec<[f64; 3]> = layout
+            .top_m
+            .iter()
+            .chain(&layout.bottom_m)
+            .copied()
+            .collect();
+        if network.fixed.len() != hinges.len() {
+            return Err(VerifyError::NetworkOfAnotherTruss {
+                fixed_nodes: network.fixed.len(),
+                attachments: hinges.len(),
+            });
+        }
+        let n_rods = frame.map_or(0, |f| f.builder.rod_count());
+        perturbation.check(network.n_edges(), n_rods, hinges.len())?;
+        let offset = |k: usize| {
+            perturbation
+                .hinge_offsets_m
+                .as_ref()
+                .map_or(Vector3::zeros(), |o| vector(&o[k]))
+        };
+        let (mut b, attachments, dead_loads) = match frame {
+            None => {
+                if perturbation.rod_stretch.is_some() {
+                    return Err(VerifyError::Unsupported(
+                        "a rigid truss has no rods to stretch".into(),
+                    ));
+                }
+                let mut b = ModelBuilder::new();
+                let points = hinges
+                    .iter()
+                    .enumerate()
+                    .map(|(k, p)| {
+                        let n = b.add_point(vector(p) + offset(k));
+                        b.fix(n, [true; 6]);
+                        n
+                    })
+                    .collect::<Vec<_>>();
+                (b, points, Vec::new())
+            }
+            Some(frame) => {
+                let RingTrussBuilder {
+                    mut builder,
+                    attachments,
+                    dead_loads,
+                    ..
+                } = frame.clone();
+                if let Some(stretch) = &perturbation.rod_stretch {
+                    builder.stretch_rods(stretch);
+                }
+                if perturbation.hinge_offsets_m.is_some() {
+                    for (k, &n) in attachments.iter().enumerate() {
+                        builder.displace_node(n, offset(k));
+                    }
+                }
+                (builder, attachments, dead_loads)
+            }
+        };
+        // Net node → model node: attachments for the fixed ones, new points for the
+        // free ones at their designed positions.
+        let mut node_of: Vec<Option<NodeId>> = vec![None; network.n_nodes()];
+        for (k, &i) in network.fixed.iter().enumerate() {
+            node_of[i] = Some(attachments[k]);
+        }
+        for (i, slot) in node_of.iter_mut().enumerate() {
+            if slot.is_none() {
+                *slot = Some(b.add_point(vector(&design.nodes_xyz_m[i])));
+            }
+        }
+        let node_of: Vec<NodeId> = node_of
+            .into_iter()
+            .map(|n| n.expect("every node mapped"))
+            .collect();
+        // The effects' dead loads: the truss's self weight, and the net's nodal
+        // loads of the design (the cables' self weight, lumped as designed).
+        for l in dead_loads {
+            b.add_load(l.node, l.force_n, l.moment_nm);
+        }
+        for (i, p) in network.loads.iter().flatten().enumerate() {
+            if p.iter().any(|&v| v != 0.0) {
+                b.add_load(node_of[i], vector(p), nalgebra::Vector3::zeros());
+            }
+        }
+        // The truss and the net's points, for the inextensible cables' stages.
+        let bare = b.clone();
+        let ea = scene.cables.axial_stiffness_n();
+        let mut ramped = b.clone();
+        let mut from_design = b.clone();
+        for (k, &[i, j]) in network.edges.iter().enumerate() {
+            let (a, c) = (node_of[i], node_of[j]);
+            let start = match (b.frame(a), b.frame(c)) {
+                (Some(fa), Some(fc)) => (fc.position_m - fa.position_m).norm(),
+                _ => 0.0,
+            };
+            let designed = scene
+                .cables
+                .cut_length_m(design.lengths_m[k], design.tensions_n[k]);
+            let cut = match &perturbation.cable_length_factors {
+                Some(f) => designed * f[k],
+                None => designed,
+            };
+            let ea = match &perturbation.cable_stiffness_factors {
+                Some(f) => ea * f[k],
+                None => ea,
+            };
+            b.add_cable(a, c, ea, [cut, cut]);
+            ramped.add_cable(a, c, ea, [start, cut]);
+            from_design.add_cable(a, c, ea, [designed, cut]);
+        }
+        Ok(AssemblyModels {
+            cut: b,
+            ramped,
+            from_design,
+            bare,
+            node_of,
+        })
+    }
+}
+
+/// Assemble `inputs`' design, as built with `perturbation`, and solve.
+///
+/// `start` is an equilibrium to start Newton from: the flexible truss's
+/// under the design's pull (the design loop's last, see [`verify`]), or a
+/// whole assembly's ([`Assembled::state`], of the same inputs) for the
+/// same assembly perturbed; without it, the truss's is solved here. From an
+/// assembly's state a perturbed one that Newton does not reach at once is
+/// followed from it with the cut lengths ramped from the design's, and
+/// fails if that fails; otherwise the last resort is the ramp from the
+/// undeformed truss.
+///
+/// # Errors
+/// As [`verify`]; a perturbation of the wrong size or one the assembly
+/// cannot take (named); inextensible cables with a perturbation.
+pub fn assemble(
+    inputs: &AssemblyInputs<'_>,
+    start: Option<&TrussEquilibrium>,
+    perturbation: &Perturbation,
+) -> Result<Assembled, VerifyError> {
+    let AssemblyInputs {
+        scene,
+        mesh,
+        effects,
+        network,
+        design,
+        frame,
+    } = *inputs;
     let clock = Instant::now();
     let n_edges = network.n_edges();
     if design.q.len() != n_edges || design.nodes_xyz_m.len() != network.n_nodes() {
@@ -177,84 +393,23 @@ pub fn verify_on_frame(
             network_nodes: network.n_nodes(),
         });
     }
+    let cable_model = effects.cable_model();
+    if cable_model == CableModel::Inextensible && !perturbation.is_none() {
+        return Err(VerifyError::Unsupported(
+            "inextensible cables (`[effects] cable_elasticity = false`) are assembled at \
+             their design lengths only"
+                .into(),
+        ));
+    }
     let layout = &mesh.truss;
-    let hinges: Vec<[f64; 3]> = layout
-        .top_m
-        .iter()
-        .chain(&layout.bottom_m)
-        .copied()
-        .collect();
-    if network.fixed.len() != hinges.len() {
-        return Err(VerifyError::NetworkOfAnotherTruss {
-            fixed_nodes: network.fixed.len(),
-            attachments: hinges.len(),
-        });
-    }
-
-    let (mut b, attachments, dead_loads) = match frame {
-        None => {
-            let mut b = ModelBuilder::new();
-            let points = hinges
-                .iter()
-                .map(|p| {
-                    let n = b.add_point(vector(p));
-                    b.fix(n, [true; 6]);
-                    n
-                })
-                .collect::<Vec<_>>();
-            (b, points, Vec::new())
-        }
-        Some(frame) => {
-            let RingTrussBuilder {
-                builder,
-                attachments,
-                dead_loads,
-                ..
-            } = frame.clone();
-            (builder, attachments, dead_loads)
-        }
-    };
-    // Net node → model node: attachments for the fixed ones, new points for the
-    // free ones at their designed positions.
-    let mut node_of: Vec<Option<NodeId>> = vec![None; network.n_nodes()];
-    for (k, &i) in network.fixed.iter().enumerate() {
-        node_of[i] = Some(attachments[k]);
-    }
-    for (i, slot) in node_of.iter_mut().enumerate() {
-        if slot.is_none() {
-            *slot = Some(b.add_point(vector(&design.nodes_xyz_m[i])));
-        }
-    }
-    let node_of: Vec<NodeId> = node_of
-        .into_iter()
-        .map(|n| n.expect("every node mapped"))
-        .collect();
-    // The effects' dead loads: the truss's self weight, and the net's nodal
-    // loads of the design (the cables' self weight, lumped as designed).
-    for l in dead_loads {
-        b.add_load(l.node, l.force_n, l.moment_nm);
-    }
-    for (i, p) in network.loads.iter().flatten().enumerate() {
-        if p.iter().any(|&v| v != 0.0) {
-            b.add_load(node_of[i], vector(p), nalgebra::Vector3::zeros());
-        }
-    }
-    // The truss and the net's points, for the inextensible cables' stages.
-    let bare = b.clone();
+    let AssemblyModels {
+        cut: b,
+        ramped,
+        from_design,
+        bare,
+        node_of,
+    } = AssemblyModels::new(inputs, perturbation)?;
     let ea = scene.cables.axial_stiffness_n();
-    let mut ramped = b.clone();
-    for (k, &[i, j]) in network.edges.iter().enumerate() {
-        let (a, c) = (node_of[i], node_of[j]);
-        let start = match (b.frame(a), b.frame(c)) {
-            (Some(fa), Some(fc)) => (fc.position_m - fa.position_m).norm(),
-            _ => 0.0,
-        };
-        let cut = scene
-            .cables
-            .cut_length_m(design.lengths_m[k], design.tensions_n[k]);
-        b.add_cable(a, c, ea, [cut, cut]);
-        ramped.add_cable(a, c, ea, [start, cut]);
-    }
     let settings = StaticSettings {
         tolerance: 1e-12,
         ..StaticSettings::default()
@@ -264,18 +419,25 @@ pub fn verify_on_frame(
     // motion being many times the cables' elastic stretch); then, if that
     // fails, from the undeformed truss with the prestrain ramped in load steps.
     let mut found = None;
-    let guess = match (frame, equilibrium) {
+    // A whole assembly's state, or the truss's alone?
+    let whole = start.is_some_and(|e| e.state.frames.len() == b.node_count());
+    let guess = match (frame, start) {
+        (None, Some(e)) if whole => Some(Cow::Borrowed(e)),
         (None, _) => None,
         (Some(_), Some(e)) => Some(Cow::Borrowed(e)),
         (Some(frame), None) => truss_guess(frame, layout, design)?.map(Cow::Owned),
     };
-    if let Some(guess) = guess {
-        let solver = StaticSolver::new(b.build()?)?;
+    let start_of = |solver: &StaticSolver, guess: &TrussEquilibrium| {
         let mut start = solver.reference_state();
         let frames = &guess.state.frames;
         start.frames[..frames.len()].copy_from_slice(frames);
         start.set_multipliers(&guess.state);
         start.rescale_multipliers(guess.constraint_scale / constraint_scale(solver.model()));
+        start
+    };
+    if let Some(guess) = &guess {
+        let solver = StaticSolver::new(b.build()?)?;
+        let start = start_of(&solver, guess);
         // One Newton solve, no step cuts, a few iterations: from a good
         // guess it converges at once; otherwise the ramp below is the
         // better path.
@@ -286,6 +448,18 @@ pub fn verify_on_frame(
         };
         let s = solver.solve_from(start, 0.0, &once)?;
         if s.converged() {
+            found = Some((solver, s));
+        } else if whole && !perturbation.is_none() {
+            // A perturbed assembly from the design's: its cut lengths
+            // ramped from the design's, in load steps.
+            let solver = StaticSolver::new(from_design.build()?)?;
+            let start = start_of(&solver, guess);
+            let s = solver.solve_from(start, 0.0, &settings)?;
+            // At load factor 1 its model is the perturbed assembly's. If it
+            // fails, so does the assembly: the ramp from the undeformed
+            // truss would repeat the design's whole assembly to find what
+            // this path could not (and took minutes for nothing on
+            // small-hex's samples of 2 mm cut-length errors).
             found = Some((solver, s));
         }
     }
@@ -304,7 +478,6 @@ pub fn verify_on_frame(
         });
     }
     // Inextensible cables: the elastic equilibrium stiffened in stages.
-    let cable_model = effects.cable_model();
     let (solver, solution, newton_iterations, load_steps) = match cable_model {
         CableModel::Elastic => {
             let (n, s) = (solution.newton_iterations, solution.steps.len());
@@ -320,9 +493,91 @@ pub fn verify_on_frame(
             stiffening::stiffen(&bare, &targets, ea, solver, solution, &settings)?
         }
     };
+    let mut verification = measure(
+        inputs,
+        &node_of,
+        solver.model(),
+        &solution.state.frames,
+        cable_model,
+    )?;
+    verification.newton_iterations = newton_iterations;
+    verification.load_steps = load_steps;
+    verification.time_s = clock.elapsed().as_secs_f64();
+    let state = TrussEquilibrium {
+        constraint_scale: constraint_scale(solver.model()),
+        state: solution.state,
+    };
+    Ok(Assembled {
+        verification,
+        state,
+        solver,
+    })
+}
+
+impl Assembled {
+    /// The assembly's tangent at its equilibrium, factored once: the
+    /// first-order response of the same assembly perturbed
+    /// ([`Linearised::respond`]).
+    ///
+    /// # Errors
+    /// A tangent that cannot be factored.
+    pub fn linearise(&self) -> Result<Linearised<'_>, VerifyError> {
+        Ok(Linearised {
+            tangent: self.solver.linearise(&self.state.state, 1.0)?,
+        })
+    }
+}
+
+/// An assembly's tangent at its equilibrium, factored ([`Assembled::linearise`]).
+pub struct Linearised<'a> {
+    tangent: Linearisation<'a>,
+}
+
+impl Linearised<'_> {
+    /// The assembly of `inputs` (those the linearised one was made of) as
+    /// built with `perturbation`, to first order in it: one solve with the
+    /// factored tangent. Its `newton_iterations` and `load_steps` are 0.
+    ///
+    /// # Errors
+    /// A perturbation of the wrong size or one the assembly cannot take.
+    pub fn respond(
+        &self,
+        inputs: &AssemblyInputs<'_>,
+        perturbation: &Perturbation,
+    ) -> Result<Verification, VerifyError> {
+        let clock = Instant::now();
+        let models = AssemblyModels::new(inputs, perturbation)?;
+        let model = models.cut.build()?;
+        let state = self.tangent.respond(&model)?;
+        let cable_model = inputs.effects.cable_model();
+        let mut v = measure(inputs, &models.node_of, &model, &state.frames, cable_model)?;
+        v.time_s = clock.elapsed().as_secs_f64();
+        Ok(v)
+    }
+}
+
+/// The assembled equilibrium `frames` of `model` judged against the design
+/// (iterations, steps and time left 0 for the caller).
+fn measure(
+    inputs: &AssemblyInputs<'_>,
+    node_of: &[NodeId],
+    model: &Model,
+    frames: &[Frame],
+    cable_model: CableModel,
+) -> Result<Verification, VerifyError> {
+    let AssemblyInputs {
+        scene,
+        mesh,
+        network,
+        design,
+        frame,
+        ..
+    } = *inputs;
+    let truss = match frame {
+        Some(_) => AssemblyTruss::Flexible,
+        None => AssemblyTruss::Rigid,
+    };
     let ea = cable_model.axial_stiffness_n(&scene.cables);
-    let model = solver.model();
-    let frames = &solution.state.frames;
     let nodes_xyz_m: Vec<[f64; 3]> = node_of
         .iter()
         .map(|&n| array(&frames[n].position_m))
@@ -372,9 +627,9 @@ pub fn verify_on_frame(
         boundary_deviation_mm: 1e3 * boundary,
         max_node_shift_mm: 1e3 * shift,
         slack_cables,
-        newton_iterations,
-        load_steps,
-        time_s: clock.elapsed().as_secs_f64(),
+        newton_iterations: 0,
+        load_steps: 0,
+        time_s: 0.0,
         nodes_xyz_m,
         tensions_n,
         truss_segments_m,
@@ -398,7 +653,7 @@ fn truss_guess(
 
 /// Tension of every cable of `model` at `frames` (full prestrain), and the
 /// slack ones.
-fn cable_tensions(model: &Model, frames: &[crate::mechanics::Frame]) -> (Vec<f64>, Vec<usize>) {
+fn cable_tensions(model: &Model, frames: &[Frame]) -> (Vec<f64>, Vec<usize>) {
     let mut slack = Vec::new();
     let tensions = model
         .cables()

@@ -7,6 +7,7 @@
 
 mod accuracy_vs_time;
 mod aperture;
+mod budget;
 mod canvas;
 mod convergence;
 mod frame_path;
@@ -16,6 +17,7 @@ mod surface_error;
 
 pub use accuracy_vs_time::{study_plot, StudyRms};
 pub use aperture::aperture_plot;
+pub use budget::budget_plot;
 pub use convergence::convergence_plot;
 pub use frame_path::{path_plot, PathFigure};
 pub use front::{front_plot, FrontRms};
