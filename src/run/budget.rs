@@ -170,7 +170,7 @@ pub fn budget(
             "budget",
             &scene,
             whole,
-            run.points,
+            (run.points, Vec::new()),
             settings_json,
             POINT_COLUMNS,
             &lines,
