@@ -58,11 +58,11 @@ pub enum Command {
     /// cable) and writes network.json (interchange format, design positions,
     /// uniform initial q per group) and mesh.vtu (for ParaView).
     ///
-    /// Example: ringmesh mesh problems/paper-26m.toml -o results/paper-26m
+    /// Example: ringmesh mesh problems/paper-26m.toml
     Mesh {
         /// The scene file (TOML).
         scene: PathBuf,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -71,7 +71,7 @@ pub enum Command {
     /// Writes nodes (equilibrium xyz), lengths, forces, reactions (per fixed node,
     /// in the order of `fixed`) and max_residual.
     ///
-    /// Example: ringmesh fdm results/paper-26m/network.json -o equilibrium.json
+    /// Example: ringmesh fdm runs/paper-26m/network.json -o equilibrium.json
     Fdm {
         /// The network file (JSON: nodes, edges, fixed, q, loads?, groups?).
         network: PathBuf,
@@ -110,7 +110,7 @@ pub enum Command {
         /// Most outer iterations.
         #[arg(long, default_value_t = 50)]
         max_iterations: usize,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -141,7 +141,7 @@ pub enum Command {
         /// loads, bisection otherwise].
         #[arg(long, value_enum)]
         solver: Option<SolverKind>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -166,7 +166,7 @@ pub enum Command {
         /// The limit margin each truss is sized for (1 … 4).
         #[arg(long, default_value_t = 2.0)]
         margin: f64,
-        /// Output folder [default: results/<scene name>/apertures].
+        /// Output folder [default: runs/<scene name>/apertures].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -184,7 +184,7 @@ pub enum Command {
         /// loads, bisection otherwise].
         #[arg(long, value_enum)]
         solver: Option<SolverKind>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -246,7 +246,7 @@ pub enum Command {
         /// write front.shard-I-of-N.csv; join the shards with `ringmesh merge`.
         #[arg(long, value_name = "I/N")]
         shard: Option<Shard>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -305,7 +305,7 @@ pub enum Command {
         /// accuracy-vs-time.shard-I-of-N.csv; join with `ringmesh merge`.
         #[arg(long, value_name = "I/N")]
         shard: Option<Shard>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -316,12 +316,12 @@ pub enum Command {
     /// settings, else nothing is written. Writes front.csv/.png/.svg or
     /// accuracy-vs-time.csv/.png/.svg.
     ///
-    /// Example: ringmesh merge results/realistic-26m
+    /// Example: ringmesh merge runs/realistic-26m
     Merge {
         /// Shard files, or folders holding them.
         #[arg(required = true)]
         paths: Vec<PathBuf>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -336,7 +336,7 @@ pub enum Command {
     Frame {
         /// The frame file (TOML).
         file: PathBuf,
-        /// Output JSON file [default: results/<file stem>/frame.json]; the
+        /// Output JSON file [default: runs/<file stem>/frame.json]; the
         /// path's frame-path.csv/.png/.svg are written beside it.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -345,7 +345,7 @@ pub enum Command {
     /// with its initial q) or to loads from a file: attachment displacements.
     ///
     /// Loads file: {"loads_n": [[fx, fy, fz], ...]}, top hinges then bottom
-    /// hinges, N. Writes truss-<model>.json to results/<scene>/.
+    /// hinges, N. Writes truss-<model>.json to runs/<scene>/.
     ///
     /// Example: ringmesh truss problems/paper-26m.toml --model linear
     Truss {
@@ -357,7 +357,7 @@ pub enum Command {
         /// Attachment loads (JSON) instead of the net's pull.
         #[arg(long)]
         loads: Option<PathBuf>,
-        /// Output JSON file [default: results/<scene name>/truss-<model>.json].
+        /// Output JSON file [default: runs/<scene name>/truss-<model>.json].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },

@@ -169,7 +169,7 @@ fn cables_note(v: &Verification) -> &'static str {
 /// `ringmesh design`: reads the scene, runs [`crate::design::run`] and writes
 /// `design.json`, `cables.csv`, `convergence.csv/.png/.svg`,
 /// `surface-error.png` and `model.vtu` into `output_dir` (default
-/// `results/<scene>/`), all together or none ([`OutputSet`]: the folder is
+/// `runs/<scene>/`), all together or none ([`OutputSet`]: the folder is
 /// locked and checked before any computing). `observe` sees each outer
 /// iteration.
 ///

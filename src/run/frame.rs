@@ -118,13 +118,13 @@ pub struct FrameCounts {
     pub joints: usize,
 }
 
-/// Where `ringmesh frame FILE` writes by default: `results/<file stem>/frame.json`.
+/// Where `ringmesh frame FILE` writes by default: `runs/<file stem>/frame.json`.
 pub fn default_frame_output(frame_path: &Path) -> PathBuf {
     let stem = frame_path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "frame".into());
-    Path::new("results").join(stem).join("frame.json")
+    super::default_dir_named(&stem).join("frame.json")
 }
 
 impl FrameOutput {

@@ -131,9 +131,20 @@ pub(crate) fn target_line(scene: &Scene, facet_rms_mm: f64) -> Option<String> {
     })
 }
 
-/// Where a scene's results go by default: `results/<scene name>/`.
+/// The folder every command writes under when `-o` is not given: `runs/`,
+/// which git ignores, so that no command writes over the committed results in
+/// `results/` unless `-o` names them.
+pub const RUNS_DIR: &str = "runs";
+
+/// Where a scene's results go by default: `runs/<scene name>/`.
 pub fn default_output_dir(scene: &Scene) -> PathBuf {
-    Path::new("results").join(&scene.name)
+    default_dir_named(&scene.name)
+}
+
+/// `runs/<name>/`: the default folder of a run named `name` (a scene's name,
+/// a frame file's stem).
+pub fn default_dir_named(name: &str) -> PathBuf {
+    Path::new(RUNS_DIR).join(name)
 }
 
 /// Writes a shard's CSV, `<stem>.shard-I-of-N.csv`, in `dir`.

@@ -77,7 +77,7 @@ pub fn section_line(t: &SectionTrial) -> String {
 /// given; else the outer diameter is searched at the scene's `d/D`), sizes
 /// its truss for `margin` and writes `sizing.csv` (every section tried) and
 /// `<scene>-sized.toml` (the scene with the chosen section, named
-/// `<scene>-sized`) into `output_dir` (default `results/<scene>/`).
+/// `<scene>-sized`) into `output_dir` (default `runs/<scene>/`).
 /// `observe` sees each section tried.
 ///
 /// # Errors
