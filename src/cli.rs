@@ -52,6 +52,16 @@ fn parse_bytes(text: &str) -> Result<u64, String> {
 
 #[derive(Subcommand)]
 pub enum Command {
+    /// Write a commented starting scene: every key with its unit and meaning
+    /// (optional ones commented out with their defaults); it designs as it is.
+    /// Never writes over an existing file. The keys in full: docs/scene.md.
+    ///
+    /// Example: ringmesh init problems/my-dish.toml
+    Init {
+        /// The scene file to write [default: runs/my-dish.toml]; its stem
+        /// names the scene.
+        path: Option<PathBuf>,
+    },
     /// Build the front net, rear net and ties of a scene.
     ///
     /// Prints a summary (free/fixed nodes, cables per group, shortest and longest
@@ -60,7 +70,7 @@ pub enum Command {
     ///
     /// Example: ringmesh mesh problems/paper-26m.toml
     Mesh {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
@@ -91,7 +101,7 @@ pub enum Command {
     ///
     /// Example: ringmesh design problems/realistic-26m.toml --relaxation anderson,paper
     Design {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The uniformity solver [default: lp for one uniformity set without
         /// loads, bisection otherwise].
@@ -128,7 +138,7 @@ pub enum Command {
     ///
     /// Example: ringmesh size problems/paper-26m.toml --margin 2 --sections problems/carbon-tubes.csv
     Size {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The limit margin to reach: the multiple of the design's pull the
         /// truss must carry stably (1 … 4).
@@ -158,7 +168,7 @@ pub enum Command {
     ///
     /// Example: ringmesh apertures problems/paper-26m.toml --apertures 26,40,60,80,100
     Apertures {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The apertures, m, comma-separated.
         #[arg(long, value_delimiter = ',', default_value = "26,40,60,80,100")]
@@ -178,7 +188,7 @@ pub enum Command {
     ///
     /// Example: ringmesh optimize problems/small-hex.toml --solver bisection
     Optimize {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The uniformity solver [default: lp for one uniformity set without
         /// loads, bisection otherwise].
@@ -223,7 +233,7 @@ pub enum Command {
     ///
     /// Example: ringmesh front problems/small-hex.toml --solvers bisection,least-squares --points 8
     Front {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// Solvers to sweep.
         #[arg(
@@ -263,7 +273,7 @@ pub enum Command {
     ///
     /// Example: ringmesh study problems/realistic-26m.toml
     Study {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// Knobs to sweep, comma-separated.
         #[arg(
@@ -349,7 +359,7 @@ pub enum Command {
     ///
     /// Example: ringmesh truss problems/paper-26m.toml --model linear
     Truss {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// Truss model [default: the scene's effects.truss].
         #[arg(long, value_enum)]

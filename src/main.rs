@@ -94,6 +94,7 @@ fn print(summary: &Summary) {
 /// its progress shown on stderr; returns what it prints.
 fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
     Ok(match command {
+        Command::Init { path } => run::init(path.as_deref())?.summary(),
         Command::Mesh { scene, output } => run::mesh(scene, output.as_deref())?.summary(),
         Command::Fdm { network, output } => run::fdm(network, output)?.summary(),
         Command::Design {

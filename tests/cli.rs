@@ -710,6 +710,7 @@ fn every_command_without_an_output_folder_leaves_a_clean_checkout() {
     .unwrap();
     let scene = "problems/small-hex.toml";
     let runs: &[&[&str]] = &[
+        &["init"],
         &["mesh", scene],
         &["optimize", scene],
         &["design", scene],
@@ -750,4 +751,46 @@ fn every_command_without_an_output_folder_leaves_a_clean_checkout() {
     ] {
         assert!(clone.join(written).is_file(), "{written} not written");
     }
+}
+
+/// `ringmesh init PATH` writes a commented scene named after the file that
+/// designs as it is; a second `init` on the same path is refused (exit 2)
+/// and leaves the file as it was.
+#[test]
+fn init_writes_a_commented_scene_that_designs_and_never_overwrites() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("new-dish.toml");
+    let run = common::ringmesh(&["init", scene.to_str().unwrap()]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("name = \"new-dish\""), "{text}");
+    assert!(text.contains("# elements_per_rod = 4"), "{text}");
+
+    std::fs::write(&scene, format!("# mine\n{text}")).unwrap();
+    let again = common::ringmesh(&["init", scene.to_str().unwrap()]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&again.stderr).contains("exists"),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    assert!(std::fs::read_to_string(&scene).unwrap().starts_with("# mine\n"));
+
+    let out = dir.path().join("out");
+    let design = common::ringmesh(&[
+        "design",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        design.status.success(),
+        "{}",
+        String::from_utf8_lossy(&design.stderr)
+    );
+    assert!(out.join("design.json").is_file());
 }

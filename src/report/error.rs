@@ -68,6 +68,12 @@ pub enum ReportError {
         /// The run whose manifest records it.
         run: String,
     },
+    /// A file that must not be written over is there (`ringmesh init`).
+    #[error("{path} exists: nothing was written; name a new file")]
+    Exists {
+        /// The file.
+        path: PathBuf,
+    },
     /// A value could not be serialised (a non-finite number in JSON, say).
     #[error("serialising {}: {source}", shown(path).display())]
     Json {
@@ -85,7 +91,10 @@ impl ReportError {
     pub fn is_bad_input(&self) -> bool {
         matches!(
             self,
-            ReportError::Busy { .. } | ReportError::Name { .. } | ReportError::Unwritable { .. }
+            ReportError::Busy { .. }
+                | ReportError::Name { .. }
+                | ReportError::Unwritable { .. }
+                | ReportError::Exists { .. }
         )
     }
 }

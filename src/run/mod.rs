@@ -19,6 +19,7 @@ mod design;
 mod fdm;
 mod frame;
 mod front;
+mod init;
 mod merge;
 mod mesh;
 mod optimize;
@@ -38,6 +39,7 @@ pub use frame::{
     FrameReaction,
 };
 pub use front::{front, FrontOutcome};
+pub use init::{default_init_path, init, InitOutcome};
 pub use merge::{merge, MergeOutcome, MergedTable};
 pub use mesh::{mesh, MeshOutcome};
 pub use optimize::{optimize, OptimizeOutcome};
