@@ -133,8 +133,9 @@ pub enum Command {
     /// problems/carbon-tubes.csv) are searched by bisection, lightest first;
     /// without, the outer diameter at the scene's d/D and material. Every rod
     /// gets the section. Writes sizing.csv (every section tried: mass, margin,
-    /// outer iterations, RMS as built) and <scene>-sized.toml; one line per
-    /// section on stderr.
+    /// outer iterations, RMS as built), sizing.png/.svg (margin against mass,
+    /// the chosen section marked) and <scene>-sized.toml (the input file with
+    /// its tube lines changed, comments kept); one line per section on stderr.
     ///
     /// Example: ringmesh size problems/paper-26m.toml --margin 2 --sections problems/carbon-tubes.csv
     Size {

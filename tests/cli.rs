@@ -719,10 +719,24 @@ fn every_command_without_an_output_folder_leaves_a_clean_checkout() {
         &["apertures", scene, "--apertures", "4"],
         &["front", scene, "--solvers", "bisection", "--points", "2"],
         &[
-            "front", scene, "--solvers", "bisection", "--points", "2", "--shard", "0/1",
+            "front",
+            scene,
+            "--solvers",
+            "bisection",
+            "--points",
+            "2",
+            "--shard",
+            "0/1",
         ],
         &["merge", "runs/small-hex"],
-        &["study", scene, "--knobs", "tolerance", "--tolerances", "1e-3"],
+        &[
+            "study",
+            scene,
+            "--knobs",
+            "tolerance",
+            "--tolerances",
+            "1e-3",
+        ],
         &["frame", "problems/frames/cantilever-moment.toml"],
         &["cantilever", "--elements", "2"],
     ];
@@ -778,7 +792,9 @@ fn init_writes_a_commented_scene_that_designs_and_never_overwrites() {
         "{}",
         String::from_utf8_lossy(&again.stderr)
     );
-    assert!(std::fs::read_to_string(&scene).unwrap().starts_with("# mine\n"));
+    assert!(std::fs::read_to_string(&scene)
+        .unwrap()
+        .starts_with("# mine\n"));
 
     let out = dir.path().join("out");
     let design = common::ringmesh(&[

@@ -24,9 +24,13 @@
 //!   designs measure it) bracketed and narrowed until the lightest carrying
 //!   diameter is within 0.5 % of one that does not, or its margin is within
 //!   3 % of `M`.
+//!
+//! The sized scene is written as the input's own text with the tube lines
+//! changed ([`sized_scene_text`]).
 
 pub mod catalogue;
 mod error;
+mod scene_file;
 
 use std::time::Instant;
 
@@ -35,6 +39,7 @@ use serde::Serialize;
 
 pub use catalogue::TubeSection;
 pub use error::SizingError;
+pub use scene_file::sized_scene_text;
 
 use crate::design::{DesignError, DesignRun, DesignSettings, LoopSummary};
 use crate::geometry::RingTrussLayout;
