@@ -1,5 +1,6 @@
 //! The documentation against the code it describes: every key the scene
-//! reader accepts has a row in `docs/scene.md`.
+//! reader accepts has a row in `docs/scene.md`; `docs/solvers.md` and
+//! `--help` give each solver the same text; the README stays a page.
 
 mod common;
 
@@ -96,4 +97,56 @@ fn every_scene_key_has_an_entry_in_the_scene_reference() {
         missing.is_empty(),
         "scene keys without a row in docs/scene.md: {missing:?}"
     );
+}
+
+/// `docs/solvers.md`, word for word what `--help` says of each solver: both
+/// are [`SolverKind::description`] (the help through clap's possible values).
+#[test]
+fn the_solver_page_and_the_help_say_the_same_of_every_solver() {
+    use ringmesh::uniformity::SolverKind;
+    let page = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/solvers.md"),
+    )
+    .expect("docs/solvers.md");
+    let help = common::ringmesh(&["design", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    for solver in SolverKind::ALL {
+        let text = solver.description();
+        assert!(
+            page.contains(&format!("## `{}`\n\n{text}\n", solver.name())),
+            "docs/solvers.md does not quote {}'s description",
+            solver.name()
+        );
+        assert!(
+            help.contains(&format!("- {}:", solver.name())) && help.contains(text),
+            "--help does not give {}'s description:\n{help}",
+            solver.name()
+        );
+    }
+}
+
+/// The README stays a page: the details live in docs/.
+#[test]
+fn the_readme_fits_on_a_page_and_links_every_doc() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    assert!(
+        readme.lines().count() <= 200,
+        "README: {} lines",
+        readme.lines().count()
+    );
+    for doc in [
+        "docs/scene.md",
+        "docs/commands.md",
+        "docs/solvers.md",
+        "docs/results.md",
+        "docs/benchmarks.md",
+        "docs/ARCHITECTURE.md",
+    ] {
+        assert!(
+            readme.contains(&format!("]({doc})")),
+            "README does not link {doc}"
+        );
+        assert!(root.join(doc).is_file(), "{doc} missing");
+    }
 }
