@@ -97,7 +97,8 @@ pub enum Command {
     /// the truss takes (‖G(C) − C‖∞ ≤ --tol). The design is then cut to length
     /// and assembled on the undeformed flexible truss. Writes design.json,
     /// cables.csv (with cut lengths), convergence.csv, convergence.png/.svg,
-    /// surface-error.png and model.vtu; one line per outer iteration on stderr.
+    /// surface-error.png and model.vtu; one line per outer iteration on stderr,
+    /// then one per stage after the loop (a bar when stderr is a terminal).
     ///
     /// Example: ringmesh design problems/realistic-26m.toml --relaxation anderson,paper
     Design {
@@ -135,7 +136,8 @@ pub enum Command {
     /// gets the section. Writes sizing.csv (every section tried: mass, margin,
     /// outer iterations, RMS as built), sizing.png/.svg (margin against mass,
     /// the chosen section marked) and <scene>-sized.toml (the input file with
-    /// its tube lines changed, comments kept); one line per section on stderr.
+    /// its tube lines changed, comments kept); one line per section on stderr,
+    /// and per outer iteration and stage of its design (a spinner on a terminal).
     ///
     /// Example: ringmesh size problems/paper-26m.toml --margin 2 --sections problems/carbon-tubes.csv
     Size {

@@ -809,4 +809,13 @@ fn init_writes_a_commented_scene_that_designs_and_never_overwrites() {
         String::from_utf8_lossy(&design.stderr)
     );
     assert!(out.join("design.json").is_file());
+    // Off a terminal, one line per stage after the loop as it begins.
+    let stderr = String::from_utf8_lossy(&design.stderr);
+    let stages: Vec<&str> = stderr.lines().filter(|l| l.starts_with("stage ")).collect();
+    assert_eq!(stages.len(), 4, "{stderr}");
+    assert!(
+        stages[0].starts_with("stage 1/4 at ")
+            && stages[0].ends_with("limit margin: the truss's limit load under the design's pull"),
+        "{stderr}"
+    );
 }

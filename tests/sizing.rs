@@ -202,6 +202,17 @@ fn the_sized_scene_keeps_the_inputs_comments_and_designs_again_after_editing_rin
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    // Progress off a terminal: each outer iteration and stage of the
+    // section's design on a line, then the section's own line.
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    for line in [
+        "  50.0/46.0 mm tube: anderson   0  boundary change",
+        "  50.0/46.0 mm tube: limit margin: the truss's limit load",
+        "  50.0/46.0 mm tube: the conventional design assembled",
+        "\n50.0/46.0 mm tube: 31 kg, margin",
+    ] {
+        assert!(stderr.contains(line), "no {line:?} in:\n{stderr}");
+    }
     let sized = std::fs::read_to_string(out.join("small-hex-sized.toml")).unwrap();
     for kept in [
         "# A small test scene: a hexagonal ring of 6 bays",

@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{default_output_dir, read_scene, target_line, Summary};
-use crate::design::{DesignReport, DesignSettings, IterationRecord, RelaxationKind};
+use crate::design::{
+    DesignObserver, DesignReport, DesignSettings, IterationRecord, RelaxationKind,
+};
 use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::report::{
@@ -183,13 +185,36 @@ pub fn design(
     output_dir: Option<&Path>,
     observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
 ) -> Result<DesignOutcome, Error> {
+    design_observed(scene_path, settings, output_dir, &mut Iterations(observe))
+}
+
+/// An observer of the outer iterations alone.
+struct Iterations<'a>(&'a mut dyn FnMut(RelaxationKind, &IterationRecord));
+
+impl DesignObserver for Iterations<'_> {
+    fn iteration(&mut self, relaxation: RelaxationKind, record: &IterationRecord) {
+        (self.0)(relaxation, record)
+    }
+}
+
+/// [`design`], with `observer` told of each outer iteration and of each
+/// stage after the loop as it begins.
+///
+/// # Errors
+/// As [`design`].
+pub fn design_observed(
+    scene_path: &Path,
+    settings: &DesignSettings,
+    output_dir: Option<&Path>,
+    observer: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, Error> {
     let clock = Instant::now();
     let scene = read_scene(scene_path)?;
     let read_s = clock.elapsed().as_secs_f64();
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     check_scene(&scene, SceneCommand::Design, 1)?;
     let set = OutputSet::begin(&dir, &FILES)?;
-    let mut run = crate::design::run(&scene, settings, observe)?;
+    let mut run = crate::design::run_observed(&scene, settings, observer)?;
     run.report.timings.read_s = read_s;
     let written = write_design(set, &scene, &run.mesh, &run.network, &mut run.report, clock)?;
     Ok(DesignOutcome {

@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 
 pub use apertures::{aperture_line, apertures, AperturesOutcome};
 pub use cantilever::{cantilever, CantileverTable, CantileverTableRow};
-pub use design::{design, iteration_line, DesignOutcome};
+pub use design::{design, design_observed, iteration_line, DesignOutcome};
 pub use fdm::{fdm, FdmOutcome, FdmOutput};
 pub use frame::{
     default_frame_output, frame, FrameCounts, FrameNodeOutput, FrameOutcome, FrameOutput,

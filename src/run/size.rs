@@ -8,7 +8,10 @@ use crate::design::DesignSettings;
 use crate::mechanics::LimitBound;
 use crate::report::{readable, sizing_csv, sizing_plot, write_atomic, OutputSet};
 use crate::resources::{check_scene, SceneCommand};
-use crate::sizing::{catalogue, size_truss, sized_scene_text, SectionTrial, Sections, Sizing};
+use crate::sizing::{
+    catalogue, size_truss_observed, sized_scene_text, SectionTrial, Sections, Sizing,
+    SizingObserver,
+};
 use crate::Error;
 
 /// What `ringmesh size` made.
@@ -80,7 +83,8 @@ pub fn section_line(t: &SectionTrial) -> String {
 /// marked) and
 /// `<scene>-sized.toml` (the input file with the chosen section's tube
 /// lines, named `<scene>-sized`: its comments and layout kept) into `output_dir` (default `runs/<scene>/`).
-/// `observe` sees each section tried.
+/// `observer` sees each section tried, and each outer iteration and stage
+/// of its design.
 ///
 /// # Errors
 /// The scene's, the catalogue's and the sizing's errors, and the writers';
@@ -91,7 +95,7 @@ pub fn size(
     sections: Option<&Path>,
     settings: &DesignSettings,
     output_dir: Option<&Path>,
-    observe: &mut dyn FnMut(&SectionTrial),
+    observer: &mut dyn SizingObserver,
 ) -> Result<SizeOutcome, Error> {
     let scene = read_scene(scene_path)?;
     let sections = match sections {
@@ -108,7 +112,7 @@ pub fn size(
         &dir,
         &["sizing.csv", "sizing.png", "sizing.svg", &toml_name],
     )?;
-    let mut sizing = size_truss(&scene, &sections, margin, settings, observe)?;
+    let mut sizing = size_truss_observed(&scene, &sections, margin, settings, observer)?;
     sizing.scene.name = sized_name;
     // The input's own text with the tube lines changed (comments and choices
     // kept); the scene as serialised only if that text cannot be edited.
