@@ -809,8 +809,19 @@ fn init_writes_a_commented_scene_that_designs_and_never_overwrites() {
         String::from_utf8_lossy(&design.stderr)
     );
     assert!(out.join("design.json").is_file());
-    // Off a terminal, one line per stage after the loop as it begins.
+    // Off a terminal, one line per stage after the loop as it begins; the
+    // iterations name Tmax/Tmin and write their numbers plainly from 1e-3.
     let stderr = String::from_utf8_lossy(&design.stderr);
+    let iterations: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("boundary change"))
+        .collect();
+    assert!(!iterations.is_empty(), "{stderr}");
+    for line in iterations {
+        assert!(line.contains(" Tmax/Tmin 1.") && !line.contains("ratio"), "{line}");
+        let elapsed = line.split_whitespace().rev().nth(1).unwrap();
+        assert!(!elapsed.contains('e'), "{line}");
+    }
     let stages: Vec<&str> = stderr.lines().filter(|l| l.starts_with("stage ")).collect();
     assert_eq!(stages.len(), 4, "{stderr}");
     assert!(

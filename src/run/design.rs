@@ -11,9 +11,9 @@ use crate::design::{
 use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::report::{
-    assembly_vtu, cables_csv, convergence_csv, convergence_plot, json_name, readable, surface_plot,
-    write_atomic, write_json, OutputSet, PanelContent, PanelRms, SurfaceFigure, SurfacePanel,
-    WithRun,
+    assembly_vtu, cables_csv, convergence_csv, convergence_plot, decimal, json_name, readable,
+    surface_plot, write_atomic, write_json, OutputSet, PanelContent, PanelRms, SurfaceFigure,
+    SurfacePanel, WithRun,
 };
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
@@ -42,13 +42,13 @@ impl DesignOutcome {
         let mut s = Summary::default();
         say!(
             s,
-            "{}: {} after {} outer iterations of {}, boundary residual {:.3e} m, ratio {:.6}",
+            "{}: {} after {} outer iterations of {}, boundary residual {} m, Tmax/Tmin {}",
             r.relaxation.name(),
             json_name(&r.termination),
             r.outer_iterations,
             r.solver,
-            r.boundary_residual_m,
-            r.ratio
+            readable(r.boundary_residual_m, 4),
+            readable(r.ratio, 7)
         );
         let v = &r.verification;
         say!(
@@ -149,13 +149,13 @@ fn budget_lines(b: &SurfaceBudget) -> Vec<String> {
 /// stderr).
 pub fn iteration_line(relaxation: RelaxationKind, r: &IterationRecord) -> String {
     format!(
-        "{:>8} {:>3}  boundary change {:.3e} m  ratio {:.6}  truss Newton {}  {:.2} s",
+        "{:>8} {:>3}  boundary change {} m  Tmax/Tmin {}  truss Newton iterations {}  {} s",
         relaxation.name(),
         r.iteration,
-        r.boundary_change_max_m,
-        r.ratio,
+        readable(r.boundary_change_max_m, 4),
+        readable(r.ratio, 7),
         r.oracle_newton_iterations,
-        r.elapsed_s
+        decimal(r.elapsed_s, 3)
     )
 }
 

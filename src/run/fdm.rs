@@ -7,7 +7,7 @@ use serde::Serialize;
 use super::Summary;
 use crate::fdm::solve_network;
 use crate::network::Network;
-use crate::report::write_json;
+use crate::report::{readable, write_json};
 use crate::Error;
 
 /// The output of `ringmesh fdm`.
@@ -38,7 +38,11 @@ impl FdmOutcome {
     /// What `ringmesh fdm` prints: the largest residual, the file written.
     pub fn summary(&self) -> Summary {
         let mut s = Summary::default();
-        say!(s, "max residual: {:.3e} N", self.output.max_residual);
+        say!(
+            s,
+            "max residual: {} N",
+            readable(self.output.max_residual, 4)
+        );
         s.written(std::slice::from_ref(&self.written));
         s
     }

@@ -12,7 +12,7 @@ use crate::mechanics::{
     rotation, CriticalPoint, MechanicsError, PathPoint, StaticSolver, StaticTermination, StepRecord,
 };
 use crate::report::{
-    json_name, path_plot, readable, write_atomic, write_json, OutputSet, PathFigure,
+    decimal, json_name, path_plot, readable, write_atomic, write_json, OutputSet, PathFigure,
 };
 use crate::Error;
 
@@ -200,8 +200,8 @@ fn frame_summary(o: &FrameOutput) -> String {
     };
     format!(
         "{}: {} nodes ({} rods, {} elements, {} bodies, {} joints); {} in {} load steps, \
-         {} Newton iterations, {} rejected steps, {:.3} ms; largest displacement {:.6e} m \
-         at {at}; largest reaction {:.6e} N, {:.6e} N·m.",
+         {} Newton iterations, {} rejected steps, {} ms; largest displacement {} m \
+         at {at}; largest reaction {} N, {} N·m.",
         o.file,
         c.nodes,
         c.rods,
@@ -212,10 +212,10 @@ fn frame_summary(o: &FrameOutput) -> String {
         o.load_steps,
         o.newton_iterations,
         o.rejected_steps,
-        1e3 * o.time_s,
-        o.max_displacement_m,
-        reaction,
-        moment
+        decimal(1e3 * o.time_s, 4),
+        readable(o.max_displacement_m, 7),
+        readable(reaction, 7),
+        readable(moment, 7)
     ) + &o
         .critical_points
         .iter()

@@ -225,6 +225,32 @@ impl SolverKind {
         }
     }
 
+    /// The solver's accuracy knob as a reader names it, with its unit
+    /// (`"ε, N"`: bisection's equilibrium tolerance; `"w"`: gradient's
+    /// dimensionless weight; `"λ"`: least squares' Tikhonov weight); `None`
+    /// for `lp`, which has none.
+    pub fn knob_label(self) -> Option<&'static str> {
+        match self {
+            SolverKind::Bisection => Some("equilibrium tolerance ε (N)"),
+            SolverKind::Lp => None,
+            SolverKind::Gradient | SolverKind::GradientSmooth => Some("weight w"),
+            SolverKind::LeastSquares => Some("Tikhonov weight λ"),
+        }
+    }
+
+    /// A knob value as printed: `ε = 0.7 N`, `w = 100`, `λ = 1e-6`
+    /// (`value` written by [`crate::report::readable`]-like rules: plain
+    /// decimals from 1e-3 to 1e6).
+    pub fn knob_text(self, value: f64) -> String {
+        let v = crate::report::readable(value, 3);
+        match self {
+            SolverKind::Bisection => format!("ε = {v} N"),
+            SolverKind::Lp => format!("knob {v}"),
+            SolverKind::Gradient | SolverKind::GradientSmooth => format!("w = {v}"),
+            SolverKind::LeastSquares => format!("λ = {v}"),
+        }
+    }
+
     /// What the solver does, in one paragraph: the text of `--help` and of
     /// `docs/solvers.md` (a test checks the document quotes it verbatim).
     pub fn description(self) -> &'static str {
