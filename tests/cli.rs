@@ -818,7 +818,10 @@ fn init_writes_a_commented_scene_that_designs_and_never_overwrites() {
         .collect();
     assert!(!iterations.is_empty(), "{stderr}");
     for line in iterations {
-        assert!(line.contains(" Tmax/Tmin 1.") && !line.contains("ratio"), "{line}");
+        assert!(
+            line.contains(" Tmax/Tmin 1.") && !line.contains(" ratio "),
+            "{line}"
+        );
         let elapsed = line.split_whitespace().rev().nth(1).unwrap();
         assert!(!elapsed.contains('e'), "{line}");
     }
