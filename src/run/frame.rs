@@ -439,7 +439,10 @@ fn path_figure(output: &FrameOutput) -> PathFigure {
         .unwrap_or(0);
     let x = |u: &[[f64; 3]], step: usize| u.first().map_or(step as f64, |u| u[component]);
     let x_label = output.path.nodes.first().map_or("step".to_string(), |n| {
-        format!("{n}: displacement {} (m)", ["x", "y", "z"][component])
+        format!(
+            "displacement {} of node \"{n}\" (the first [output] node), m",
+            ["x", "y", "z"][component]
+        )
     });
     PathFigure {
         title: format!("equilibrium path of {}", output.file),
