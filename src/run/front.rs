@@ -39,7 +39,7 @@ impl FrontOutcome {
                     s,
                     "{} {}: Tmax/Tmin {}, RMS {} mm, {} s ({})",
                     study::value_name(&p.solver),
-                    p.solver.knob_text(p.knob),
+                    p.solver.knob_text(&readable(p.knob, 3)),
                     readable(p.ratio, 7),
                     readable(p.rms_mm, 4),
                     readable(p.time_s, 3),
@@ -49,7 +49,7 @@ impl FrontOutcome {
                     s,
                     "{} {}: failed: {e}",
                     study::value_name(&p.solver),
-                    p.solver.knob_text(p.knob)
+                    p.solver.knob_text(&readable(p.knob, 3))
                 ),
             }
         }
@@ -125,7 +125,7 @@ pub fn front(
         progress.step(&format!(
             "{} {}: {outcome}",
             study::value_name(&p.solver),
-            p.solver.knob_text(p.knob)
+            p.solver.knob_text(&readable(p.knob, 3))
         ));
     });
     let Some(set) = set else {

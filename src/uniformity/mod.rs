@@ -238,11 +238,9 @@ impl SolverKind {
         }
     }
 
-    /// A knob value as printed: `ε = 0.7 N`, `w = 100`, `λ = 1e-6`
-    /// (`value` written by [`crate::report::readable`]-like rules: plain
-    /// decimals from 1e-3 to 1e6).
-    pub fn knob_text(self, value: f64) -> String {
-        let v = crate::report::readable(value, 3);
+    /// A knob value as printed, `value` the number as written (`ε = 0.7 N`,
+    /// `w = 100`, `λ = 1e-6`).
+    pub fn knob_text(self, v: &str) -> String {
         match self {
             SolverKind::Bisection => format!("ε = {v} N"),
             SolverKind::Lp => format!("knob {v}"),

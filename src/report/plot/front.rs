@@ -153,7 +153,7 @@ where
             let list: Vec<String> = failed
                 .iter()
                 .map(|(solver, knob)| match solver_kind(solver) {
-                    Some(kind) => format!("{solver} {}", kind.knob_text(*knob)),
+                    Some(kind) => format!("{solver} {}", kind.knob_text(&readable(*knob, 3))),
                     None => format!("{solver} at {}", readable(*knob, 3)),
                 })
                 .collect();
