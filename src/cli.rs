@@ -52,17 +52,27 @@ fn parse_bytes(text: &str) -> Result<u64, String> {
 
 #[derive(Subcommand)]
 pub enum Command {
+    /// Write a commented starting scene: every key with its unit and meaning
+    /// (optional ones commented out with their defaults); it designs as it is.
+    /// Never writes over an existing file. The keys in full: docs/scene.md.
+    ///
+    /// Example: ringmesh init problems/my-dish.toml
+    Init {
+        /// The scene file to write [default: runs/my-dish.toml]; its stem
+        /// names the scene.
+        path: Option<PathBuf>,
+    },
     /// Build the front net, rear net and ties of a scene.
     ///
     /// Prints a summary (free/fixed nodes, cables per group, shortest and longest
     /// cable) and writes network.json (interchange format, design positions,
     /// uniform initial q per group) and mesh.vtu (for ParaView).
     ///
-    /// Example: ringmesh mesh problems/paper-26m.toml -o results/paper-26m
+    /// Example: ringmesh mesh problems/paper-26m.toml
     Mesh {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -77,7 +87,7 @@ pub enum Command {
     /// (created). A folder is never replaced: fdm.json is written into it,
     /// beside what it holds. The folder is checked writable before computing.
     ///
-    /// Example: ringmesh fdm results/paper-26m/network.json -o equilibrium.json
+    /// Example: ringmesh fdm runs/paper-26m/network.json -o equilibrium.json
     Fdm {
         /// The network file (JSON: nodes, edges, fixed, q, loads?, groups?).
         network: PathBuf,
@@ -93,11 +103,12 @@ pub enum Command {
     /// the truss takes (‖G(C) − C‖∞ ≤ --tol). The design is then cut to length
     /// and assembled on the undeformed flexible truss. Writes design.json,
     /// cables.csv (with cut lengths), convergence.csv, convergence.png/.svg,
-    /// surface-error.png and model.vtu; one line per outer iteration on stderr.
+    /// surface-error.png and model.vtu; one line per outer iteration on stderr,
+    /// then one per stage after the loop (a bar when stderr is a terminal).
     ///
     /// Example: ringmesh design problems/realistic-26m.toml --relaxation anderson,paper
     Design {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The uniformity solver [default: lp for one uniformity set without
         /// loads, bisection otherwise].
@@ -116,7 +127,7 @@ pub enum Command {
         /// Most outer iterations.
         #[arg(long, default_value_t = 50)]
         max_iterations: usize,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -129,12 +140,14 @@ pub enum Command {
     /// problems/carbon-tubes.csv) are searched by bisection, lightest first;
     /// without, the outer diameter at the scene's d/D and material. Every rod
     /// gets the section. Writes sizing.csv (every section tried: mass, margin,
-    /// outer iterations, RMS as built) and <scene>-sized.toml; one line per
-    /// section on stderr.
+    /// outer iterations, RMS as built), sizing.png/.svg (margin against mass,
+    /// the chosen section marked) and <scene>-sized.toml (the input file with
+    /// its tube lines changed, comments kept); one line per section on stderr,
+    /// and per outer iteration and stage of its design (a spinner on a terminal).
     ///
     /// Example: ringmesh size problems/paper-26m.toml --margin 2 --sections problems/carbon-tubes.csv
     Size {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The limit margin to reach: the multiple of the design's pull the
         /// truss must carry stably (1 … 4).
@@ -147,7 +160,7 @@ pub enum Command {
         /// loads, bisection otherwise].
         #[arg(long, value_enum)]
         solver: Option<SolverKind>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -164,7 +177,7 @@ pub enum Command {
     ///
     /// Example: ringmesh apertures problems/paper-26m.toml --apertures 26,40,60,80,100
     Apertures {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The apertures, m, comma-separated.
         #[arg(long, value_delimiter = ',', default_value = "26,40,60,80,100")]
@@ -172,7 +185,7 @@ pub enum Command {
         /// The limit margin each truss is sized for (1 … 4).
         #[arg(long, default_value_t = 2.0)]
         margin: f64,
-        /// Output folder [default: results/<scene name>/apertures].
+        /// Output folder [default: runs/<scene name>/apertures].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -184,13 +197,13 @@ pub enum Command {
     ///
     /// Example: ringmesh optimize problems/small-hex.toml --solver bisection
     Optimize {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// The uniformity solver [default: lp for one uniformity set without
         /// loads, bisection otherwise].
         #[arg(long, value_enum)]
         solver: Option<SolverKind>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -235,7 +248,7 @@ pub enum Command {
     ///
     /// Example: ringmesh front problems/small-hex.toml --solvers bisection,least-squares --points 8
     Front {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// Solvers to sweep.
         #[arg(
@@ -258,7 +271,7 @@ pub enum Command {
         /// write front.shard-I-of-N.csv; join the shards with `ringmesh merge`.
         #[arg(long, value_name = "I/N")]
         shard: Option<Shard>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -275,7 +288,7 @@ pub enum Command {
     ///
     /// Example: ringmesh study problems/realistic-26m.toml
     Study {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// Knobs to sweep, comma-separated.
         #[arg(
@@ -317,7 +330,7 @@ pub enum Command {
         /// accuracy-vs-time.shard-I-of-N.csv; join with `ringmesh merge`.
         #[arg(long, value_name = "I/N")]
         shard: Option<Shard>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -349,7 +362,7 @@ pub enum Command {
         /// `ringmesh merge`.
         #[arg(long, value_name = "I/N")]
         shard: Option<Shard>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -360,12 +373,12 @@ pub enum Command {
     /// settings, else nothing is written. Writes front.csv/.png/.svg,
     /// accuracy-vs-time.csv/.png/.svg or the budget's files.
     ///
-    /// Example: ringmesh merge results/realistic-26m
+    /// Example: ringmesh merge runs/realistic-26m
     Merge {
         /// Shard files, or folders holding them.
         #[arg(required = true)]
         paths: Vec<PathBuf>,
-        /// Output folder [default: results/<scene name>].
+        /// Output folder [default: runs/<scene name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -388,7 +401,7 @@ pub enum Command {
     Frame {
         /// The frame file (TOML).
         file: PathBuf,
-        /// Output JSON file, or folder [default: the folder results/<file
+        /// Output JSON file, or folder [default: the folder runs/<file
         /// stem>/]; the path's <stem>-path.csv/.png/.svg are written beside it.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -397,7 +410,7 @@ pub enum Command {
     /// with its initial q) or to loads from a file: attachment displacements.
     ///
     /// Loads file: {"loads_n": [[fx, fy, fz], ...]}, top hinges then bottom
-    /// hinges, N. Writes truss-<model>.json to results/<scene>/.
+    /// hinges, N. Writes truss-<model>.json to runs/<scene>/.
     ///
     /// -o names a file or a folder by one rule: an existing folder, or a path
     /// ending in /, is a folder; otherwise a path ending in .json is the file;
@@ -407,7 +420,7 @@ pub enum Command {
     ///
     /// Example: ringmesh truss problems/paper-26m.toml --model linear
     Truss {
-        /// The scene file (TOML).
+        /// The scene file (TOML; keys in docs/scene.md, a start from `ringmesh init`).
         scene: PathBuf,
         /// Truss model [default: the scene's effects.truss].
         #[arg(long, value_enum)]
@@ -416,7 +429,7 @@ pub enum Command {
         #[arg(long)]
         loads: Option<PathBuf>,
         /// Output JSON file, or a folder (receives truss-<model>.json)
-        /// [default: results/<scene name>/].
+        /// [default: runs/<scene name>/].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },

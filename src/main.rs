@@ -6,47 +6,15 @@
 //! written), 130 interrupted (SIGINT, SIGTERM, SIGHUP).
 
 mod cli;
+mod progress;
 
 use std::process::ExitCode;
 
 use clap::Parser;
-use indicatif::{ProgressBar, ProgressStyle};
-use ringmesh::run::{self, Progress, Summary};
+use ringmesh::run::{self, Summary};
 
 use cli::{Cli, Command};
-
-/// A progress bar on stderr (hidden when stderr is not a terminal).
-struct Bar(ProgressBar);
-
-impl Progress for Bar {
-    fn start(&self, total: usize) {
-        self.0.set_length(total as u64);
-    }
-    fn step(&self, message: &str) {
-        self.0.set_message(message.to_string());
-        self.0.inc(1);
-        // Not on a terminal (a batch job's log): one line per step instead.
-        if self.0.is_hidden() {
-            eprintln!(
-                "{}/{} {:.1} s {message}",
-                self.0.position(),
-                self.0.length().unwrap_or(0),
-                self.0.elapsed().as_secs_f64()
-            );
-        }
-    }
-}
-
-/// A progress bar on stderr; when stderr is not a terminal, one line per
-/// finished step instead.
-fn bar() -> Bar {
-    let bar = ProgressBar::new(0);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
-            .expect("valid template"),
-    );
-    Bar(bar)
-}
+use progress::{bar, DesignProgress, SizeProgress};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -94,6 +62,7 @@ fn print(summary: &Summary) {
 /// its progress shown on stderr; returns what it prints.
 fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
     Ok(match command {
+        Command::Init { path } => run::init(path.as_deref())?.summary(),
         Command::Mesh { scene, output } => run::mesh(scene, output.as_deref())?.summary(),
         Command::Fdm { network, output } => run::fdm(network, output)?.summary(),
         Command::Design {
@@ -113,10 +82,10 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
                 max_iterations: *max_iterations,
                 ..Default::default()
             };
-            run::design(scene, &settings, output.as_deref(), &mut |relaxation, r| {
-                eprintln!("{}", run::iteration_line(relaxation, r));
-            })?
-            .summary()
+            let mut progress = DesignProgress::new();
+            let result = run::design_observed(scene, &settings, output.as_deref(), &mut progress);
+            progress.bar.finish_and_clear();
+            result?.summary()
         }
         Command::Apertures {
             scene,
@@ -145,15 +114,17 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
                 solver: *solver,
                 ..Default::default()
             };
-            run::size(
+            let mut progress = SizeProgress::new();
+            let result = run::size(
                 scene,
                 *margin,
                 sections.as_deref(),
                 &settings,
                 output.as_deref(),
-                &mut |t| eprintln!("{}", run::section_line(t)),
-            )?
-            .summary()
+                &mut progress,
+            );
+            progress.bar.finish_and_clear();
+            result?.summary()
         }
         Command::Optimize {
             scene,

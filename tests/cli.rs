@@ -418,28 +418,9 @@ fn the_readme_main_command_leaves_a_clean_checkout() {
         .chain(command.split_whitespace())
         .collect();
     let dir = tempfile::tempdir().unwrap();
-    let clone = dir.path().join("clone");
-    let git = |args: &[&str], cwd: &std::path::Path| {
-        std::process::Command::new("git")
-            .args(args)
-            .current_dir(cwd)
-            .output()
-            .expect("git runs")
-    };
-    let cloned = git(
-        &[
-            "clone",
-            "--quiet",
-            "--local",
-            &root.display().to_string(),
-            "clone",
-        ],
-        dir.path(),
-    );
-    if !cloned.status.success() {
-        // Not a git checkout (a source tarball): nothing to keep clean.
+    let Some(clone) = fresh_clone(dir.path()) else {
         return;
-    }
+    };
     let out = common::ringmesh_in(&args, &clone);
     assert!(
         out.status.success(),
@@ -681,4 +662,174 @@ fn a_study_refused_for_its_jobs_names_them() {
     let stderr = String::from_utf8(run.stderr).unwrap();
     assert_eq!(run.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("and --jobs 1024"), "{stderr}");
+}
+
+/// A fresh clone of the repository, in `dir/clone`, or `None` when the
+/// sources are not a git checkout (a source tarball: nothing to keep clean).
+fn fresh_clone(dir: &std::path::Path) -> Option<PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let cloned = git(
+        &[
+            "clone",
+            "--quiet",
+            "--local",
+            &root.display().to_string(),
+            "clone",
+        ],
+        dir,
+    );
+    cloned.status.success().then(|| dir.join("clone"))
+}
+
+/// `git ARGS` in `cwd`.
+fn git(args: &[&str], cwd: &std::path::Path) -> std::process::Output {
+    std::process::Command::new("git")
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("git runs")
+}
+
+/// Every command that writes, run with no `-o` in a fresh clone (the small
+/// scene, few points), writes under `runs/` — which git ignores — and leaves
+/// `git status` clean: no command writes over the committed `results/`
+/// unless `-o` names them (issue 37). `fdm` and `uniformity` take a required
+/// `-o`; `cantilever` writes nothing without it.
+#[test]
+fn every_command_without_an_output_folder_leaves_a_clean_checkout() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(clone) = fresh_clone(dir.path()) else {
+        return;
+    };
+    // A one-section catalogue, outside the clone: one sizing design.
+    let catalogue = dir.path().join("one-tube.csv");
+    std::fs::write(
+        &catalogue,
+        "outer_diameter_m,inner_diameter_m\n0.05,0.046\n",
+    )
+    .unwrap();
+    let scene = "problems/small-hex.toml";
+    let runs: &[&[&str]] = &[
+        &["init"],
+        &["mesh", scene],
+        &["optimize", scene],
+        &["design", scene],
+        &["truss", scene],
+        &["size", scene, "--sections", catalogue.to_str().unwrap()],
+        &["apertures", scene, "--apertures", "4"],
+        &["front", scene, "--solvers", "bisection", "--points", "2"],
+        &[
+            "front",
+            scene,
+            "--solvers",
+            "bisection",
+            "--points",
+            "2",
+            "--shard",
+            "0/1",
+        ],
+        &["merge", "runs/small-hex"],
+        &[
+            "study",
+            scene,
+            "--knobs",
+            "tolerance",
+            "--tolerances",
+            "1e-3",
+        ],
+        &["frame", "problems/frames/cantilever-moment.toml"],
+        &["cantilever", "--elements", "2"],
+    ];
+    for args in runs {
+        let out = common::ringmesh_in(args, &clone);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let status = git(&["status", "--porcelain", "--untracked-files=all"], &clone);
+        assert!(status.status.success());
+        assert_eq!(
+            String::from_utf8_lossy(&status.stdout),
+            "",
+            "git status after {args:?}"
+        );
+    }
+    for written in [
+        "runs/small-hex/design.json",
+        "runs/small-hex/sizing.csv",
+        "runs/small-hex/apertures/apertures.csv",
+        "runs/small-hex/front.csv",
+        "runs/small-hex/accuracy-vs-time.csv",
+        "runs/cantilever-moment/frame.json",
+    ] {
+        assert!(clone.join(written).is_file(), "{written} not written");
+    }
+}
+
+/// `ringmesh init PATH` writes a commented scene named after the file that
+/// designs as it is; a second `init` on the same path is refused (exit 2)
+/// and leaves the file as it was.
+#[test]
+fn init_writes_a_commented_scene_that_designs_and_never_overwrites() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("new-dish.toml");
+    let run = common::ringmesh(&["init", scene.to_str().unwrap()]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("name = \"new-dish\""), "{text}");
+    assert!(text.contains("# elements_per_rod = 4"), "{text}");
+
+    std::fs::write(&scene, format!("# mine\n{text}")).unwrap();
+    let again = common::ringmesh(&["init", scene.to_str().unwrap()]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&again.stderr).contains("exists"),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    assert!(std::fs::read_to_string(&scene)
+        .unwrap()
+        .starts_with("# mine\n"));
+
+    let out = dir.path().join("out");
+    let design = common::ringmesh(&[
+        "design",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        design.status.success(),
+        "{}",
+        String::from_utf8_lossy(&design.stderr)
+    );
+    assert!(out.join("design.json").is_file());
+    // Off a terminal, one line per stage after the loop as it begins; the
+    // iterations name Tmax/Tmin and write their numbers plainly from 1e-3.
+    let stderr = String::from_utf8_lossy(&design.stderr);
+    let iterations: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("boundary change"))
+        .collect();
+    assert!(!iterations.is_empty(), "{stderr}");
+    for line in iterations {
+        assert!(
+            line.contains(" Tmax/Tmin 1.") && !line.contains(" ratio "),
+            "{line}"
+        );
+        let elapsed = line.split_whitespace().rev().nth(1).unwrap();
+        assert!(!elapsed.contains('e'), "{line}");
+    }
+    let stages: Vec<&str> = stderr.lines().filter(|l| l.starts_with("stage ")).collect();
+    assert_eq!(stages.len(), 4, "{stderr}");
+    assert!(
+        stages[0].starts_with("stage 1/4 at ")
+            && stages[0].ends_with("limit margin: the truss's limit load under the design's pull"),
+        "{stderr}"
+    );
 }

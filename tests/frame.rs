@@ -330,7 +330,7 @@ fn frame_command_writes_positions_rotations_reactions_and_solver_stats() {
 }
 
 #[test]
-fn frame_command_writes_to_results_by_default() {
+fn frame_command_writes_under_runs_by_default() {
     let dir = tempfile::tempdir().unwrap();
     let run = common::ringmesh_in(
         &[
@@ -346,7 +346,7 @@ fn frame_command_writes_to_results_by_default() {
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
-    let out = dir.path().join("results/ring-truss-frame/frame.json");
+    let out = dir.path().join("runs/ring-truss-frame/frame.json");
     let json: Value = serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
     assert_eq!(json["termination"]["status"], "converged");
     assert_eq!(json["reactions"].as_array().unwrap().len(), 3);
@@ -370,7 +370,7 @@ fn frame_command_rejects_a_bad_file_with_exit_code_2_and_writes_nothing() {
         "{stderr}"
     );
     assert!(!out.exists());
-    assert!(!dir.path().join("results").exists());
+    assert!(!dir.path().join("runs").exists());
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
 

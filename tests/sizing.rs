@@ -164,3 +164,83 @@ fn a_truss_model_without_a_limit_load_is_refused() {
         assert_eq!(tried, 0, "{model:?}: a section was designed");
     }
 }
+
+/// `ringmesh size` writes the sized scene as the input file with its tube
+/// lines changed: the input's comments stay, a net given by its membrane
+/// stress is not given a mean tension too, and the file — with `rings`
+/// edited, nothing else — designs again (issue 37: the written scene lost
+/// every comment and held both tension keys, so that editing `rings` alone
+/// was refused). The figure of the sections tried is written beside it.
+#[test]
+fn the_sized_scene_keeps_the_inputs_comments_and_designs_again_after_editing_rings() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = std::fs::read_to_string(common::problem("small-hex.toml"))
+        .unwrap()
+        .replace(
+            "mean_tension_n = 70.0",
+            "membrane_stress_n_per_m = 40.0  # N/m: my own note",
+        );
+    let scene = dir.path().join("hex.toml");
+    std::fs::write(&scene, &input).unwrap();
+    let catalogue = dir.path().join("tubes.csv");
+    std::fs::write(
+        &catalogue,
+        "outer_diameter_m,inner_diameter_m\n0.05,0.046\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let run = common::ringmesh(&[
+        "size",
+        scene.to_str().unwrap(),
+        "--sections",
+        catalogue.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    // Progress off a terminal: each outer iteration and stage of the
+    // section's design on a line, then the section's own line.
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    for line in [
+        "  50.0/46.0 mm tube: anderson   0  boundary change",
+        "  50.0/46.0 mm tube: limit margin: the truss's limit load",
+        "  50.0/46.0 mm tube: the conventional design assembled",
+        "\n50.0/46.0 mm tube: 31 kg, margin",
+    ] {
+        assert!(stderr.contains(line), "no {line:?} in:\n{stderr}");
+    }
+    let sized = std::fs::read_to_string(out.join("small-hex-sized.toml")).unwrap();
+    for kept in [
+        "# A small test scene: a hexagonal ring of 6 bays",
+        "# 60/56 mm tubes: with 24/22 mm the ring buckles",
+        "membrane_stress_n_per_m = 40.0  # N/m: my own note",
+        "focal_length_m = 8.0         # rear tension level ≈ 2× front.",
+    ] {
+        assert!(sized.contains(kept), "lost {kept:?}:\n{sized}");
+    }
+    assert!(sized.contains("tube_outer_diameter_m = 0.05\n"), "{sized}");
+    assert_eq!(
+        sized.matches("mean_tension_n").count(),
+        1,
+        "only the rear net's, as given:\n{sized}"
+    );
+    assert!(out.join("sizing.png").is_file());
+
+    let edited = dir.path().join("edited.toml");
+    std::fs::write(&edited, sized.replace("rings = 3", "rings = 4")).unwrap();
+    let design = common::ringmesh(&[
+        "design",
+        edited.to_str().unwrap(),
+        "-o",
+        dir.path().join("again").to_str().unwrap(),
+    ]);
+    assert!(
+        design.status.success(),
+        "{}",
+        String::from_utf8_lossy(&design.stderr)
+    );
+}

@@ -28,6 +28,7 @@
 //!   limit margin, verification by assembly, the conventional design
 //!   (the loop's iteration 0) verified on the same truss.
 
+mod observer;
 mod outer_loop;
 mod pipeline;
 mod relaxation;
@@ -35,10 +36,13 @@ mod scene_nets;
 mod summary;
 mod tied_nets;
 
+pub use observer::{DesignObserver, DesignStage};
 pub use outer_loop::{
     design_loop, design_loop_with, IterationRecord, LoopOutcome, LoopSettings, DIVERGENCE_FACTOR,
 };
-pub use pipeline::{design_margin, run, DesignReport, DesignRun, DesignSettings, LoopRun, Timings};
+pub use pipeline::{
+    design_margin, run, run_observed, DesignReport, DesignRun, DesignSettings, LoopRun, Timings,
+};
 pub use relaxation::{
     aitken_factor, paper_step, Aitken, Anderson, Paper, Relaxation, RelaxationKind, Step,
 };

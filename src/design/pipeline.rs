@@ -9,6 +9,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::observer::{DesignObserver, DesignStage, Iterations};
 use super::outer_loop::{IterationRecord, LoopOutcome, LoopSettings};
 use super::relaxation::RelaxationKind;
 use super::scene_nets::{default_solver, SceneNets};
@@ -244,6 +245,19 @@ pub fn run(
     settings: &DesignSettings,
     observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
 ) -> Result<DesignRun, DesignError> {
+    run_observed(scene, settings, &mut Iterations(observe))
+}
+
+/// [`run`], with `observer` told of each outer iteration and of each stage
+/// after the loop as it begins.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_observed(
+    scene: &Scene,
+    settings: &DesignSettings,
+    observer: &mut dyn DesignObserver,
+) -> Result<DesignRun, DesignError> {
     let clock = Instant::now();
     let mut timings = Timings::default();
     // A scene that leaves its net to a surface target gets the coarsest net
@@ -277,7 +291,7 @@ pub fn run(
         let loop_clock = Instant::now();
         let result = scene_nets.design_loop(solver.as_ref(), model, &loop_settings, &mut |r| {
             history.push(r.clone());
-            observe(relaxation, r)
+            observer.iteration(relaxation, r)
         });
         let loop_s = loop_clock.elapsed().as_secs_f64();
         if outcome.is_some() {
@@ -328,12 +342,14 @@ pub fn run(
     // The flexible truss's frame, constructed once for the loop's oracle,
     // the margin and both assemblies.
     let frame = outcome.truss_deforms.then(|| scene_nets.truss_frame());
+    observer.stage(DesignStage::Margin);
     let stage = Instant::now();
     let limit_margin = match frame {
         None => None,
         Some(frame) => Some(design_margin(frame, &outcome.design)?),
     };
     timings.margin_s = stage.elapsed().as_secs_f64();
+    observer.stage(DesignStage::Verification);
     let stage = Instant::now();
     let network = outcome.problem.network().clone();
     let sets = outcome.problem.sets().to_vec();
@@ -347,6 +363,7 @@ pub fn run(
         outcome.truss_equilibrium.as_ref(),
     )?;
     timings.verification_s = stage.elapsed().as_secs_f64();
+    observer.stage(DesignStage::Surface);
     let stage = Instant::now();
     let n_front = mesh.n_front_nodes;
     let surface = budget(
@@ -367,6 +384,7 @@ pub fn run(
         scene.front_net.chosen.as_ref(),
     )?;
     timings.surface_s = stage.elapsed().as_secs_f64();
+    observer.stage(DesignStage::Conventional);
     let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
     // undeformed attachment points, assembled from the truss's response to

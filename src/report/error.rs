@@ -91,6 +91,12 @@ pub enum ReportError {
         /// The run whose manifest records it.
         run: String,
     },
+    /// A file that must not be written over is there (`ringmesh init`).
+    #[error("{path} exists: nothing was written; name a new file")]
+    Exists {
+        /// The file.
+        path: PathBuf,
+    },
     /// A value could not be serialised (a non-finite number in JSON, say).
     #[error("serialising {}: {source}", shown(path).display())]
     Json {
@@ -113,6 +119,7 @@ impl ReportError {
                 | ReportError::Unwritable { .. }
                 | ReportError::MountPoint { .. }
                 | ReportError::OutputPath { .. }
+                | ReportError::Exists { .. }
         )
     }
 }

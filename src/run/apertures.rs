@@ -64,7 +64,7 @@ pub fn aperture_line(r: &ApertureResult) -> String {
 }
 
 /// `ringmesh apertures`: reads the scene, runs the aperture study and
-/// writes into `output_dir` (default `results/<scene>/apertures/`)
+/// writes into `output_dir` (default `runs/<scene>/apertures/`)
 /// `apertures.csv` (one row per aperture and design model),
 /// `apertures.json`, `apertures.png/.svg` and each aperture's sized scene,
 /// `<scene>-at-<D>m.toml`, which `ringmesh design` runs again. `observe`
@@ -81,7 +81,7 @@ pub fn apertures(
 ) -> Result<AperturesOutcome, Error> {
     let scene = read_scene(scene_path)?;
     let dir = output_dir.map_or_else(
-        || Path::new("results").join(&scene.name).join("apertures"),
+        || super::default_output_dir(&scene).join("apertures"),
         Path::to_path_buf,
     );
     let table = [

@@ -125,7 +125,7 @@ fn table_lines(s: &mut Summary, table: &BudgetTable) {
 
 /// `ringmesh budget`: the budget of the scene at `scene_path` with
 /// `samples` and `seed` (the scene's `[tolerances]` when not given),
-/// written into `output_dir` (default `results/<scene>/`); with `shard`,
+/// written into `output_dir` (default `runs/<scene>/`); with `shard`,
 /// only that shard's points as `budget-samples.shard-I-of-N.csv`.
 pub fn budget(
     scene_path: &Path,

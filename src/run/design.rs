@@ -5,13 +5,15 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{default_output_dir, read_scene, target_line, Summary};
-use crate::design::{DesignReport, DesignSettings, IterationRecord, RelaxationKind};
+use crate::design::{
+    DesignObserver, DesignReport, DesignSettings, IterationRecord, RelaxationKind,
+};
 use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::report::{
-    assembly_vtu, cables_csv, convergence_csv, convergence_plot, json_name, readable, surface_plot,
-    write_atomic, write_json, OutputSet, PanelContent, PanelRms, SurfaceFigure, SurfacePanel,
-    WithRun,
+    assembly_vtu, cables_csv, convergence_csv, convergence_plot, decimal, json_name, readable,
+    surface_plot, write_atomic, write_json, OutputSet, PanelContent, PanelRms, SurfaceFigure,
+    SurfacePanel, WithRun,
 };
 use crate::resources::{check_scene, SceneCommand};
 use crate::scene::Scene;
@@ -40,13 +42,13 @@ impl DesignOutcome {
         let mut s = Summary::default();
         say!(
             s,
-            "{}: {} after {} outer iterations of {}, boundary residual {:.3e} m, ratio {:.6}",
+            "{}: {} after {} outer iterations of {}, boundary residual {} m, Tmax/Tmin {}",
             r.relaxation.name(),
             json_name(&r.termination),
             r.outer_iterations,
             r.solver,
-            r.boundary_residual_m,
-            r.ratio
+            readable(r.boundary_residual_m, 4),
+            readable(r.ratio, 7)
         );
         let v = &r.verification;
         say!(
@@ -147,13 +149,13 @@ fn budget_lines(b: &SurfaceBudget) -> Vec<String> {
 /// stderr).
 pub fn iteration_line(relaxation: RelaxationKind, r: &IterationRecord) -> String {
     format!(
-        "{:>8} {:>3}  boundary change {:.3e} m  ratio {:.6}  truss Newton {}  {:.2} s",
+        "{:>8} {:>3}  boundary change {} m  Tmax/Tmin {}  truss Newton iterations {}  {} s",
         relaxation.name(),
         r.iteration,
-        r.boundary_change_max_m,
-        r.ratio,
+        readable(r.boundary_change_max_m, 4),
+        readable(r.ratio, 7),
         r.oracle_newton_iterations,
-        r.elapsed_s
+        decimal(r.elapsed_s, 3)
     )
 }
 
@@ -169,7 +171,7 @@ fn cables_note(v: &Verification) -> &'static str {
 /// `ringmesh design`: reads the scene, runs [`crate::design::run`] and writes
 /// `design.json`, `cables.csv`, `convergence.csv/.png/.svg`,
 /// `surface-error.png` and `model.vtu` into `output_dir` (default
-/// `results/<scene>/`), all together or none ([`OutputSet`]: the folder is
+/// `runs/<scene>/`), all together or none ([`OutputSet`]: the folder is
 /// locked and checked before any computing). `observe` sees each outer
 /// iteration.
 ///
@@ -183,13 +185,36 @@ pub fn design(
     output_dir: Option<&Path>,
     observe: &mut dyn FnMut(RelaxationKind, &IterationRecord),
 ) -> Result<DesignOutcome, Error> {
+    design_observed(scene_path, settings, output_dir, &mut Iterations(observe))
+}
+
+/// An observer of the outer iterations alone.
+struct Iterations<'a>(&'a mut dyn FnMut(RelaxationKind, &IterationRecord));
+
+impl DesignObserver for Iterations<'_> {
+    fn iteration(&mut self, relaxation: RelaxationKind, record: &IterationRecord) {
+        (self.0)(relaxation, record)
+    }
+}
+
+/// [`design`], with `observer` told of each outer iteration and of each
+/// stage after the loop as it begins.
+///
+/// # Errors
+/// As [`design`].
+pub fn design_observed(
+    scene_path: &Path,
+    settings: &DesignSettings,
+    output_dir: Option<&Path>,
+    observer: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, Error> {
     let clock = Instant::now();
     let scene = read_scene(scene_path)?;
     let read_s = clock.elapsed().as_secs_f64();
     let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
     check_scene(&scene, SceneCommand::Design, 1)?;
     let set = OutputSet::begin(&dir, &FILES)?;
-    let mut run = crate::design::run(&scene, settings, observe)?;
+    let mut run = crate::design::run_observed(&scene, settings, observer)?;
     run.report.timings.read_s = read_s;
     let written = write_design(set, &scene, &run.mesh, &run.network, &mut run.report, clock)?;
     Ok(DesignOutcome {

@@ -7,7 +7,7 @@ use serde::Serialize;
 use super::Summary;
 use crate::fdm::solve_network;
 use crate::network::Network;
-use crate::report::{json_bytes, OutputPath, OutputSet};
+use crate::report::{json_bytes, readable, OutputPath, OutputSet};
 use crate::resources::{check_network, SceneCommand};
 use crate::Error;
 
@@ -39,7 +39,11 @@ impl FdmOutcome {
     /// What `ringmesh fdm` prints: the largest residual, the file written.
     pub fn summary(&self) -> Summary {
         let mut s = Summary::default();
-        say!(s, "max residual: {:.3e} N", self.output.max_residual);
+        say!(
+            s,
+            "max residual: {} N",
+            readable(self.output.max_residual, 4)
+        );
         s.written(std::slice::from_ref(&self.written));
         s
     }

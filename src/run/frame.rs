@@ -13,7 +13,8 @@ use crate::mechanics::{
     StaticTermination, StepRecord,
 };
 use crate::report::{
-    json_name, path_plot, readable, write_atomic, write_json, OutputPath, OutputSet, PathFigure,
+    decimal, json_name, path_plot, readable, write_atomic, write_json, OutputPath, OutputSet,
+    PathFigure,
 };
 use crate::Error;
 
@@ -130,13 +131,13 @@ pub struct FrameCounts {
     pub joints: usize,
 }
 
-/// Where `ringmesh frame FILE` writes by default: `results/<file stem>/frame.json`.
+/// Where `ringmesh frame FILE` writes by default: `runs/<file stem>/frame.json`.
 pub fn default_frame_output(frame_path: &Path) -> PathBuf {
     let stem = frame_path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "frame".into());
-    Path::new("results").join(stem).join("frame.json")
+    super::default_dir_named(&stem).join("frame.json")
 }
 
 impl FrameOutput {
@@ -230,8 +231,8 @@ fn frame_summary(o: &FrameOutput) -> String {
     };
     format!(
         "{}: {} nodes ({} rods, {} elements, {} bodies, {} joints); {} in {} load steps, \
-         {} Newton iterations, {} rejected steps, {:.3} ms; largest displacement {:.6e} m \
-         at {at}; largest reaction {:.6e} N, {:.6e} N·m.",
+         {} Newton iterations, {} rejected steps, {} ms; largest displacement {} m \
+         at {at}; largest reaction {} N, {} N·m.",
         o.file,
         c.nodes,
         c.rods,
@@ -242,10 +243,10 @@ fn frame_summary(o: &FrameOutput) -> String {
         o.load_steps,
         o.newton_iterations,
         o.rejected_steps,
-        1e3 * o.time_s,
-        o.max_displacement_m,
-        reaction,
-        moment
+        decimal(1e3 * o.time_s, 4),
+        readable(o.max_displacement_m, 7),
+        readable(reaction, 7),
+        readable(moment, 7)
     ) + &o
         .critical_points
         .iter()
@@ -498,7 +499,10 @@ fn path_figure(output: &FrameOutput) -> PathFigure {
         .unwrap_or(0);
     let x = |u: &[[f64; 3]], step: usize| u.first().map_or(step as f64, |u| u[component]);
     let x_label = output.path.nodes.first().map_or("step".to_string(), |n| {
-        format!("{n}: displacement {} (m)", ["x", "y", "z"][component])
+        format!(
+            "displacement {} of node \"{n}\" (the first [output] node), m",
+            ["x", "y", "z"][component]
+        )
     });
     PathFigure {
         title: format!("equilibrium path of {}", output.file),

@@ -41,19 +41,19 @@ impl FrontOutcome {
             match &p.outcome {
                 Ok(t) => say!(
                     s,
-                    "{} knob {:.3e}: ratio {:.6}, RMS {:.3e} mm, {:.3} s ({})",
+                    "{} {}: Tmax/Tmin {}, RMS {} mm, {} s ({})",
                     study::value_name(&p.solver),
-                    p.knob,
-                    p.ratio,
-                    p.rms_mm,
-                    p.time_s,
+                    p.solver.knob_text(&readable(p.knob, 3)),
+                    readable(p.ratio, 7),
+                    readable(p.rms_mm, 4),
+                    readable(p.time_s, 3),
                     json_name(t)
                 ),
                 Err(e) => say!(
                     s,
-                    "{} knob {:.3e}: failed: {e}",
+                    "{} {}: failed: {e}",
                     study::value_name(&p.solver),
-                    p.knob
+                    p.solver.knob_text(&readable(p.knob, 3))
                 ),
             }
         }
@@ -122,13 +122,17 @@ pub fn front(
     progress.start(indices.len());
     let front = design_front_chains(&problem, &mine, &|p: &FrontPoint| {
         let outcome = match &p.outcome {
-            Ok(_) => format!("ratio {:.6}, RMS {:.3e} mm", p.ratio, p.rms_mm),
+            Ok(_) => format!(
+                "Tmax/Tmin {}, RMS {} mm",
+                readable(p.ratio, 7),
+                readable(p.rms_mm, 4)
+            ),
             Err(e) => format!("failed: {e}"),
         };
         progress.step(&format!(
-            "{} knob {:.3e}: {outcome}",
+            "{} {}: {outcome}",
             study::value_name(&p.solver),
-            p.knob
+            p.solver.knob_text(&readable(p.knob, 3))
         ));
     });
     let Some(set) = set else {

@@ -58,7 +58,7 @@ pub struct MergedTable {
 /// `ringmesh merge`: joins the shard CSVs among `paths` (files, or folders
 /// holding `*.shard-I-of-N.csv`) into each sweep's table and plots, exactly
 /// as the unsharded run writes them, in `output_dir` (default
-/// `results/<scene>/`). Shards of different scenes or settings, duplicate or
+/// `runs/<scene>/`). Shards of different scenes or settings, duplicate or
 /// missing shards are refused before anything is written.
 pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<MergeOutcome, Error> {
     let files = shard::find_shards(paths)?
@@ -108,7 +108,7 @@ pub fn merge(paths: &[PathBuf], output_dir: Option<&Path>) -> Result<MergeOutcom
     let mut outcomes = Vec::new();
     for (m, table) in merged.iter().zip(tables) {
         let dir = output_dir.map_or_else(
-            || Path::new("results").join(&m.header.scene),
+            || super::default_dir_named(&m.header.scene),
             Path::to_path_buf,
         );
         // The plots are drawn from the parsed rows; the table is the shards' text.

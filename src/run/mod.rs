@@ -20,6 +20,7 @@ mod design;
 mod fdm;
 mod frame;
 mod front;
+mod init;
 mod merge;
 mod mesh;
 mod optimize;
@@ -33,13 +34,14 @@ use std::path::{Path, PathBuf};
 pub use apertures::{aperture_line, apertures, AperturesOutcome};
 pub use budget::{budget, BudgetOutcome};
 pub use cantilever::{cantilever, CantileverTable, CantileverTableRow};
-pub use design::{design, iteration_line, DesignOutcome};
+pub use design::{design, design_observed, iteration_line, DesignOutcome};
 pub use fdm::{fdm, FdmOutcome, FdmOutput};
 pub use frame::{
     default_frame_output, frame, FrameCounts, FrameNodeOutput, FrameOutcome, FrameOutput,
     FrameReaction,
 };
 pub use front::{front, front_points, FrontOutcome};
+pub use init::{default_init_path, init, InitOutcome};
 pub use merge::{merge, MergeOutcome, MergedTable};
 pub use mesh::{mesh, MeshOutcome};
 pub use optimize::{optimize, OptimizeOutcome};
@@ -133,9 +135,20 @@ pub(crate) fn target_line(scene: &Scene, facet_rms_mm: f64) -> Option<String> {
     })
 }
 
-/// Where a scene's results go by default: `results/<scene name>/`.
+/// The folder every command writes under when `-o` is not given: `runs/`,
+/// which git ignores, so that no command writes over the committed results in
+/// `results/` unless `-o` names them.
+pub const RUNS_DIR: &str = "runs";
+
+/// Where a scene's results go by default: `runs/<scene name>/`.
 pub fn default_output_dir(scene: &Scene) -> PathBuf {
-    Path::new("results").join(&scene.name)
+    default_dir_named(&scene.name)
+}
+
+/// `runs/<name>/`: the default folder of a run named `name` (a scene's name,
+/// a frame file's stem).
+pub fn default_dir_named(name: &str) -> PathBuf {
+    Path::new(RUNS_DIR).join(name)
 }
 
 /// Writes a shard's CSV, `<stem>.shard-I-of-N.csv`, in `dir`; the sweep's

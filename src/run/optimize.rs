@@ -43,9 +43,9 @@ impl OptimizeOutcome {
         for set in &d.sets {
             say!(
                 s,
-                "ratio over {}: {:.6} ({} cables)",
+                "Tmax/Tmin over {}: {} ({} cables)",
                 set.name,
-                set.ratio,
+                readable(set.ratio, 7),
                 set.cables
             );
         }

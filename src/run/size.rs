@@ -6,9 +6,12 @@ use std::path::{Path, PathBuf};
 use super::{default_output_dir, read_scene, Summary};
 use crate::design::DesignSettings;
 use crate::mechanics::LimitBound;
-use crate::report::{readable, sizing_csv, write_atomic, OutputSet};
+use crate::report::{readable, sizing_csv, sizing_plot, write_atomic, OutputSet};
 use crate::resources::{check_scene, SceneCommand};
-use crate::sizing::{catalogue, size_truss, SectionTrial, Sections, Sizing};
+use crate::sizing::{
+    catalogue, size_truss_observed, sized_scene_text, SectionTrial, Sections, Sizing,
+    SizingObserver,
+};
 use crate::Error;
 
 /// What `ringmesh size` made.
@@ -75,10 +78,13 @@ pub fn section_line(t: &SectionTrial) -> String {
 
 /// `ringmesh size`: reads the scene (and the catalogue `sections`, if
 /// given; else the outer diameter is searched at the scene's `d/D`), sizes
-/// its truss for `margin` and writes `sizing.csv` (every section tried) and
-/// `<scene>-sized.toml` (the scene with the chosen section, named
-/// `<scene>-sized`) into `output_dir` (default `results/<scene>/`).
-/// `observe` sees each section tried.
+/// its truss for `margin` and writes `sizing.csv` (every section tried),
+/// `sizing.png/.svg` (their margin against their mass, the chosen one
+/// marked) and
+/// `<scene>-sized.toml` (the input file with the chosen section's tube
+/// lines, named `<scene>-sized`: its comments and layout kept) into `output_dir` (default `runs/<scene>/`).
+/// `observer` sees each section tried, and each outer iteration and stage
+/// of its design.
 ///
 /// # Errors
 /// The scene's, the catalogue's and the sizing's errors, and the writers';
@@ -89,7 +95,7 @@ pub fn size(
     sections: Option<&Path>,
     settings: &DesignSettings,
     output_dir: Option<&Path>,
-    observe: &mut dyn FnMut(&SectionTrial),
+    observer: &mut dyn SizingObserver,
 ) -> Result<SizeOutcome, Error> {
     let scene = read_scene(scene_path)?;
     let sections = match sections {
@@ -102,20 +108,50 @@ pub fn size(
     let sized_name = format!("{}-sized", scene.name);
     let toml_name = format!("{sized_name}.toml");
     check_scene(&scene, SceneCommand::Design, 1)?;
-    let set = OutputSet::begin(&dir, &["sizing.csv", &toml_name])?;
-    let mut sizing = size_truss(&scene, &sections, margin, settings, observe)?;
+    let set = OutputSet::begin(
+        &dir,
+        &["sizing.csv", "sizing.png", "sizing.svg", &toml_name],
+    )?;
+    let mut sizing = size_truss_observed(&scene, &sections, margin, settings, observer)?;
     sizing.scene.name = sized_name;
-    let text = format!(
-        "# {} with its truss sized by `ringmesh size` for a limit margin of {}.\n{}",
-        scene.name,
-        margin,
-        sizing.scene.to_toml()?
-    );
+    // The input's own text with the tube lines changed (comments and choices
+    // kept); the scene as serialised only if that text cannot be edited.
+    let edited = std::fs::read_to_string(scene_path).ok().and_then(|input| {
+        sized_scene_text(
+            &input,
+            &scene.name,
+            &sizing.scene.name,
+            &scene.truss,
+            &sizing.scene.truss,
+            margin,
+        )
+    });
+    let text = match edited {
+        Some(text) => text,
+        None => format!(
+            "# {} with its truss sized by `ringmesh size` for a limit margin of {}.\n{}",
+            scene.name,
+            margin,
+            sizing.scene.to_toml()?
+        ),
+    };
     write_atomic(
         &set.path("sizing.csv"),
         sizing_csv(&sizing.trials).as_bytes(),
     )?;
     write_atomic(&set.path(&toml_name), text.as_bytes())?;
+    let title = format!(
+        "{}: tube sections tried for a limit margin of {margin}",
+        scene.name
+    );
+    sizing_plot(
+        &sizing.trials,
+        sizing.chosen,
+        margin,
+        &title,
+        &set.path("sizing.png"),
+        &set.path("sizing.svg"),
+    )?;
     Ok(SizeOutcome {
         sizing,
         written: set.commit()?,

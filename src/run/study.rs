@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
 use crate::geometry::build_mesh;
 use crate::report::{
-    readable, study_csv, study_plot, study_row, write_atomic, OutputSet, RmsAxis, StudyRms,
-    STUDY_COLUMNS,
+    decimal, readable, study_csv, study_plot, study_row, write_atomic, OutputSet, RmsAxis,
+    StudyRms, STUDY_COLUMNS,
 };
 use crate::resources::{check_scene_jobs, SceneCommand};
 use crate::scene::{Scene, TrussModel};
@@ -113,13 +113,13 @@ impl StudyOutcome {
         );
         say!(
             s,
-            "{:>5} {:>10} {:>13} {:>9} {:>10} {:>11} {:>11} {:>13} {:>13}",
+            "{:>5} {:>10} {:>13} {:>9} {:>10} {:>13} {:>11} {:>13} {:>13}",
             "point",
             "knob",
             "value",
             "time s",
             "RMS mm",
-            "ratio err",
+            "Tmax/Tmin err",
             "tension %",
             "cut len mm",
             "facet RMS mm"
@@ -128,7 +128,7 @@ impl StudyOutcome {
             let value = if r.value.is_empty() { "-" } else { &r.value };
             let g = |v: f64| {
                 if v.is_finite() {
-                    format!("{v:.3e}")
+                    readable(v, 4)
                 } else {
                     "-".into()
                 }
@@ -142,7 +142,7 @@ impl StudyOutcome {
                 ),
                 None => say!(
                     s,
-                    "{k:>5} {:>10} {value:>13} {:>9.3} {:>10} {:>11} {:>11} {:>13} {:>13}",
+                    "{k:>5} {:>10} {value:>13} {:>9.3} {:>10} {:>13} {:>11} {:>13} {:>13}",
                     r.knob.name(),
                     r.time_s,
                     g(r.rms_mm),
@@ -246,7 +246,11 @@ pub fn study(
     let rows = study::run_study(&scene, &settings, part, options.jobs, &|r: &StudyRow| {
         let outcome = match &r.error {
             Some(e) => format!("failed: {e}"),
-            None => format!("RMS as built {:.3e} mm, design {:.2} s", r.rms_mm, r.time_s),
+            None => format!(
+                "RMS as built {} mm, design {} s",
+                readable(r.rms_mm, 4),
+                decimal(r.time_s, 3)
+            ),
         };
         let point = format!("{} {}", r.knob.name(), r.value);
         progress.step(&format!("{}: {outcome}", point.trim_end()));

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::{default_output_dir, read_scene, Summary};
-use crate::report::{json_bytes, OutputPath, OutputSet};
+use crate::report::{decimal, json_bytes, readable, OutputPath, OutputSet};
 use crate::scene::TrussModel;
 use crate::truss::SceneTrussResponse;
 use crate::Error;
@@ -27,18 +27,24 @@ impl TrussOutcome {
         let mut s = Summary::default();
         say!(
             s,
-            "{} truss under loads from {}: max displacement {:.6e} m, {} Newton iterations, {} load steps, {:.3} s",
-            r.model, r.loads_from, r.max_displacement_m, r.newton_iterations, r.load_steps, r.time_s
+            "{} truss under loads from {}: max displacement {} m, {} Newton iterations, {} load \
+             steps, {} s",
+            r.model,
+            r.loads_from,
+            readable(r.max_displacement_m, 7),
+            r.newton_iterations,
+            r.load_steps,
+            decimal(r.time_s, 3)
         );
         for a in &r.attachments {
             let d = a.displacement_m;
             say!(
                 s,
-                "  {:<10} u = [{:+.4e}, {:+.4e}, {:+.4e}] m",
+                "  {:<10} u = [{}, {}, {}] m",
                 a.hinge,
-                d[0],
-                d[1],
-                d[2]
+                readable(d[0], 5),
+                readable(d[1], 5),
+                readable(d[2], 5)
             );
         }
         s.written(std::slice::from_ref(&self.written));

@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::Summary;
 use crate::algebra::norm3;
 use crate::network::Network;
-use crate::report::{json_bytes, json_name, OutputPath, OutputSet};
+use crate::report::{json_bytes, json_name, readable, OutputPath, OutputSet};
 use crate::uniformity::{
     Route, SolverKind, SurfaceTarget, Termination, UniformityError, UniformityProblem,
     UniformitySet,
@@ -57,8 +57,8 @@ impl UniformityOutcome {
     pub fn summary(&self) -> Summary {
         let o = &self.output;
         let mut s = Summary::default();
-        say!(s, "ratio: {:.6}", o.ratio);
-        say!(s, "max residual: {:.3e} N", o.max_residual);
+        say!(s, "Tmax/Tmin: {}", readable(o.ratio, 7));
+        say!(s, "max residual: {} N", readable(o.max_residual, 4));
         say!(
             s,
             "termination: {} after {} iterations of {}, {:.3} s",

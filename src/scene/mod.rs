@@ -25,12 +25,14 @@
 //! The files: `error` (the error), `schema` (the TOML syntax: one struct per
 //! table, and what a scene's values imply), `read` (text to a scene),
 //! `validate` (every value against its range), `rod_properties` (the
-//! measured-rods table).
+//! measured-rods table), `template` (the commented scene `ringmesh init`
+//! writes). The reference of every key is `docs/scene.md`.
 
 mod error;
 mod read;
 mod rod_properties;
 mod schema;
+mod template;
 mod validate;
 
 pub use error::SceneError;
@@ -40,6 +42,7 @@ pub use schema::{
     Supports, SurfaceSpec, Thermal, ThermalCase, Tolerances, Truss, TrussModel, UniformNet,
     Uniformity,
 };
+pub use template::template;
 pub use validate::{
     modulus_range, MAX_BAYS, MAX_ELEMENTS_PER_ROD, MAX_HEIGHT_RATIO, MAX_MODULUS_PA, MAX_NAME_LEN,
     MIN_MODULUS_PA,

@@ -24,9 +24,13 @@
 //!   designs measure it) bracketed and narrowed until the lightest carrying
 //!   diameter is within 0.5 % of one that does not, or its margin is within
 //!   3 % of `M`.
+//!
+//! The sized scene is written as the input's own text with the tube lines
+//! changed ([`sized_scene_text`]).
 
 pub mod catalogue;
 mod error;
+mod scene_file;
 
 use std::time::Instant;
 
@@ -35,8 +39,12 @@ use serde::Serialize;
 
 pub use catalogue::TubeSection;
 pub use error::SizingError;
+pub use scene_file::sized_scene_text;
 
-use crate::design::{DesignError, DesignRun, DesignSettings, LoopSummary};
+use crate::design::{
+    DesignError, DesignObserver, DesignRun, DesignSettings, DesignStage, IterationRecord,
+    LoopSummary, RelaxationKind,
+};
 use crate::geometry::RingTrussLayout;
 use crate::mechanics::LimitBound;
 #[cfg(doc)]
@@ -130,6 +138,61 @@ pub fn size_truss(
     settings: &DesignSettings,
     observe: &mut dyn FnMut(&SectionTrial),
 ) -> Result<Sizing, SizingError> {
+    size_truss_observed(scene, sections, margin, settings, &mut Trials(observe))
+}
+
+/// Sees a sizing as it goes; every method does nothing by default.
+pub trait SizingObserver {
+    /// A section was tried (its design finished, or failed).
+    fn trial(&mut self, _trial: &SectionTrial) {}
+    /// An outer iteration of the design on `section` finished.
+    fn iteration(
+        &mut self,
+        _section: &TubeSection,
+        _relaxation: RelaxationKind,
+        _record: &IterationRecord,
+    ) {
+    }
+    /// A stage after the design loop on `section` begins.
+    fn stage(&mut self, _section: &TubeSection, _stage: DesignStage) {}
+}
+
+/// An observer of the sections tried alone.
+struct Trials<'a>(&'a mut dyn FnMut(&SectionTrial));
+
+impl SizingObserver for Trials<'_> {
+    fn trial(&mut self, trial: &SectionTrial) {
+        (self.0)(trial)
+    }
+}
+
+/// A sizing's observer seen by one section's design.
+struct SectionDesign<'a> {
+    section: &'a TubeSection,
+    observer: &'a mut dyn SizingObserver,
+}
+
+impl DesignObserver for SectionDesign<'_> {
+    fn iteration(&mut self, relaxation: RelaxationKind, record: &IterationRecord) {
+        self.observer.iteration(self.section, relaxation, record)
+    }
+    fn stage(&mut self, stage: DesignStage) {
+        self.observer.stage(self.section, stage)
+    }
+}
+
+/// [`size_truss`], with `observer` told of each section tried and of each
+/// outer iteration and stage of its design.
+///
+/// # Errors
+/// As [`size_truss`].
+pub fn size_truss_observed(
+    scene: &Scene,
+    sections: &Sections,
+    margin: f64,
+    settings: &DesignSettings,
+    observe: &mut dyn SizingObserver,
+) -> Result<Sizing, SizingError> {
     if !((1.0..=SEARCH_TO).contains(&margin)) {
         return Err(SizingError::Margin {
             value: margin,
@@ -209,7 +272,7 @@ struct Search<'a> {
     scene: &'a Scene,
     margin: f64,
     settings: &'a DesignSettings,
-    observe: &'a mut dyn FnMut(&SectionTrial),
+    observe: &'a mut dyn SizingObserver,
     trials: Vec<SectionTrial>,
     /// The lightest carrying trial so far and its run.
     best: Option<(usize, DesignRun)>,
@@ -224,7 +287,14 @@ impl Search<'_> {
         let mass_kg =
             RingTrussLayout::of(&scene).rod_length_m() * section.mass_per_length_kg_per_m();
         let clock = Instant::now();
-        let result = crate::design::run(&scene, self.settings, &mut |_, _| {});
+        let result = crate::design::run_observed(
+            &scene,
+            self.settings,
+            &mut SectionDesign {
+                section: &section,
+                observer: &mut *self.observe,
+            },
+        );
         let time_s = clock.elapsed().as_secs_f64();
         let mut trial = SectionTrial {
             section,
@@ -263,7 +333,7 @@ impl Search<'_> {
                 _ => return Err(e.into()),
             },
         }
-        (self.observe)(&trial);
+        self.observe.trial(&trial);
         let carries = trial.carries;
         self.trials.push(trial);
         if let Some(run) = run.filter(|_| carries) {

@@ -188,27 +188,120 @@ pub trait UniformitySolver: Send + Sync {
     }
 }
 
-/// The solvers, by name (the command line's choice).
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, clap::ValueEnum, serde::Serialize, serde::Deserialize,
-)]
+/// The solvers, by name (the command line's choice). What each does is
+/// [`SolverKind::description`]: the one text `--help` shows and
+/// `docs/solvers.md` quotes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SolverKind {
-    /// Ratio bisection over LP/SOCP feasibility (clarabel).
+    /// Ratio bisection over conic feasibility programs (clarabel).
     Bisection,
-    /// One LP (clarabel): the homogeneous single-set baseline.
+    /// One LP: the single-set homogeneous baseline.
     Lp,
-    /// Free geometry: adjoint L-BFGS (argmin) from a far start, finished by
-    /// sequential quadratic programs on the unsmoothed `ln(Tmax/Tmin)` — the
-    /// true minimiser for the weight.
+    /// Free geometry, finished by quadratic programs on the exact ratio.
     Gradient,
-    /// `gradient` without its finish: L-BFGS on the soft max/min alone.
+    /// Free geometry by L-BFGS on a smoothed ratio alone.
     GradientSmooth,
     /// Constrained or Tikhonov least squares (faer).
     LeastSquares,
 }
 
+impl clap::ValueEnum for SolverKind {
+    fn value_variants<'a>() -> &'a [Self] {
+        &SolverKind::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()).help(self.description()))
+    }
+}
+
 impl SolverKind {
+    /// Every solver, in the order `--help` lists them.
+    pub const ALL: [SolverKind; 5] = [
+        SolverKind::Bisection,
+        SolverKind::Lp,
+        SolverKind::Gradient,
+        SolverKind::GradientSmooth,
+        SolverKind::LeastSquares,
+    ];
+
+    /// The name used on the command line and in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::Bisection => "bisection",
+            SolverKind::Lp => "lp",
+            SolverKind::Gradient => "gradient",
+            SolverKind::GradientSmooth => "gradient-smooth",
+            SolverKind::LeastSquares => "least-squares",
+        }
+    }
+
+    /// The solver's accuracy knob as a reader names it, with its unit
+    /// (`"ε, N"`: bisection's equilibrium tolerance; `"w"`: gradient's
+    /// dimensionless weight; `"λ"`: least squares' Tikhonov weight); `None`
+    /// for `lp`, which has none.
+    pub fn knob_label(self) -> Option<&'static str> {
+        match self {
+            SolverKind::Bisection => Some("equilibrium tolerance ε (N)"),
+            SolverKind::Lp => None,
+            SolverKind::Gradient | SolverKind::GradientSmooth => Some("weight w"),
+            SolverKind::LeastSquares => Some("Tikhonov weight λ"),
+        }
+    }
+
+    /// A knob value as printed, `value` the number as written (`ε = 0.7 N`,
+    /// `w = 100`, `λ = 1e-6`).
+    pub fn knob_text(self, v: &str) -> String {
+        match self {
+            SolverKind::Bisection => format!("ε = {v} N"),
+            SolverKind::Lp => format!("knob {v}"),
+            SolverKind::Gradient | SolverKind::GradientSmooth => format!("w = {v}"),
+            SolverKind::LeastSquares => format!("λ = {v}"),
+        }
+    }
+
+    /// What the solver does, in one paragraph: the text of `--help` and of
+    /// `docs/solvers.md` (a test checks the document quotes it verbatim).
+    pub fn description(self) -> &'static str {
+        match self {
+            SolverKind::Bisection => {
+                "Fixed geometry. Bisection on the ratio Tmax/Tmin: each trial ratio is one \
+                 elastic feasibility program (an LP, or an SOCP when the equilibrium \
+                 tolerance epsilon_n > 0) solved by clarabel. Handles several uniformity \
+                 groups, nodal loads (gravity) and the bound [q]; the default where lp does \
+                 not apply. Knob: epsilon_n (N), the equilibrium residual allowed."
+            }
+            SolverKind::Lp => {
+                "Fixed geometry. One LP, min Tmax/Tmin, for one uniformity group without \
+                 nodal loads, rescaled to the target mean tension. A tied net's plan problem \
+                 is solved by the crate's own structured interior point (src/uniformity/ipm/); \
+                 should it stop short, or on any other network, clarabel solves it. The \
+                 default where it applies. No knob."
+            }
+            SolverKind::Gradient => {
+                "Free geometry: minimises (RMS/1 mm)² + w·ln(Tmax/Tmin) (plus layout, level \
+                 and bound terms) by its adjoint gradient. From lp's optimum (where lp \
+                 applies) or a neighbouring design it goes straight to sequential quadratic \
+                 programs on the exact ratio, each solved by an interior point on the net's \
+                 structure; from a far start argmin's L-BFGS on a smoothed ratio first \
+                 brings it near. Knob: the weight w (dimensionless)."
+            }
+            SolverKind::GradientSmooth => {
+                "Free geometry: gradient without its finish, argmin's L-BFGS on a smoothed \
+                 (log-sum-exp) ratio alone, from the same starts; its minimiser sits slightly \
+                 off the exact objective's. Knob: the weight w (dimensionless)."
+            }
+            SolverKind::LeastSquares => {
+                "Fixed geometry. The tensions closest to their targets, min ‖Lq − T̄‖², in \
+                 exact equilibrium or traded against it (Tikhonov, min ‖Aq − p‖² + \
+                 λ‖Lq − T̄‖²): one sparse KKT system (faer). Does not enforce 0 < q ≤ [q]: \
+                 a design that breaks them is an error naming the cables. Knob: lambda \
+                 (dimensionless)."
+            }
+        }
+    }
+
     /// The default solver of a problem with `sets` uniformity sets, loaded
     /// (`loaded`: nodal loads such as the cables' weight) or not: [`Lp`] —
     /// one LP, a unique design, the fastest route — where it applies (one set,

@@ -198,6 +198,14 @@ where
     area.draw(&Text::new(
         "Pareto-optimal among the designs of the reference's net (the reference excluded)",
         (x + 14, y - 8),
+        font.clone(),
+    ))?;
+    area.draw(&Text::new(
+        format!(
+            "An error below an axis's floor — RMS {RMS_FLOOR_MM:e} mm, ratio error \
+             {RATIO_ERROR_FLOOR:e}, an exact zero among them — is drawn at the floor."
+        ),
+        (90, y + 14),
         font,
     ))?;
     Ok(())
@@ -212,7 +220,7 @@ fn draw_study<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let (charts, legend) = titled_with_legend(&root, title, 35)?;
+    let (charts, legend) = titled_with_legend(&root, title, 55)?;
     let panels = charts.split_evenly((1, 2));
     let surface = StudyPanel {
         y_desc: rms.caption(),

@@ -92,6 +92,7 @@ where
     }
     chart
         .configure_series_labels()
+        .position(legend_corner(&figure.points, (x0, x1), (y0, y1)))
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
@@ -99,9 +100,67 @@ where
     Ok(root.present()?)
 }
 
+/// The corner of the plot the legend covers least of the path: not the one
+/// the path starts in, then the one holding the fewest of its points (each
+/// corner a box of 40 % of either range).
+fn legend_corner(
+    points: &[(f64, f64)],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> SeriesLabelPosition {
+    let fraction = |v: f64, lo: f64, hi: f64| if hi > lo { (v - lo) / (hi - lo) } else { 0.5 };
+    let corner_of = |&(x, y): &(f64, f64)| {
+        let (fx, fy) = (fraction(x, x0, x1), fraction(y, y0, y1));
+        let side = |f: f64| {
+            if f <= 0.4 {
+                Some(false)
+            } else if f >= 0.6 {
+                Some(true)
+            } else {
+                None
+            }
+        };
+        Some((side(fx)?, side(fy)?))
+    };
+    let start = points.first().and_then(corner_of);
+    // (right, upper) for each corner.
+    let corners = [
+        ((false, true), SeriesLabelPosition::UpperLeft),
+        ((true, true), SeriesLabelPosition::UpperRight),
+        ((true, false), SeriesLabelPosition::LowerRight),
+        ((false, false), SeriesLabelPosition::LowerLeft),
+    ];
+    corners
+        .into_iter()
+        .filter(|(c, _)| Some(*c) != start)
+        .min_by_key(|(c, _)| points.iter().filter(|p| corner_of(p) == Some(*c)).count())
+        .map_or(SeriesLabelPosition::UpperRight, |(_, position)| position)
+}
+
 /// Draws a followed equilibrium path (load factor against a recorded
 /// displacement, critical points marked by kind) as PNG and SVG, each
 /// written atomically.
 pub fn path_plot(figure: &PathFigure, png: &Path, svg: &Path) -> Result<(), ReportError> {
     png_and_svg!(draw_path, (900, 600), png, svg, figure)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A path that starts at the lower left and climbs to the upper right
+    /// gets its legend in a corner it leaves empty, never over its start.
+    #[test]
+    fn the_legend_never_covers_the_paths_start() {
+        let points: Vec<(f64, f64)> = (0..=20).map(|k| (k as f64, k as f64)).collect();
+        let corner = legend_corner(&points, (0.0, 20.0), (0.0, 20.0));
+        assert!(matches!(
+            corner,
+            SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
+        ));
+        let start_upper_left: Vec<(f64, f64)> =
+            (0..=20).map(|k| (k as f64, 20.0 - k as f64)).collect();
+        let corner = legend_corner(&start_upper_left, (0.0, 20.0), (0.0, 20.0));
+        assert!(!matches!(corner, SeriesLabelPosition::UpperLeft));
+    }
 }

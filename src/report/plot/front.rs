@@ -11,6 +11,7 @@ use super::canvas::{png_and_svg, titled_with_legend};
 use super::labels::{label_font, place_labels};
 use super::{total_rms_mm, RMS_FLOOR_MM};
 use crate::report::{readable, DrawError, FrontRow, ReportError};
+use crate::uniformity::SolverKind;
 
 /// The surface RMS the front's points are drawn at (`--rms`,
 /// [`super::RmsAxis`]).
@@ -59,7 +60,7 @@ where
     DB::ErrorType: 'static,
 {
     let ok: Vec<&FrontRow> = points.iter().filter(|p| p.ratio.is_finite()).collect();
-    let (plot, legend) = titled_with_legend(&root, title, 60)?;
+    let (plot, legend) = titled_with_legend(&root, title, 72)?;
     let x = |p: &FrontRow| rms.of(p).max(RMS_FLOOR_MM);
     let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
     for p in &ok {
@@ -136,23 +137,25 @@ where
         FrontRms::Design => {
             legend.draw(&Circle::new((at, 14), 4, BLACK.stroke_width(2)))?;
             legend.draw(&Text::new(
-                format!("RMS below {RMS_FLOOR_MM:.0e} mm, drawn at it; labels: the knob"),
+                format!("RMS below {RMS_FLOOR_MM:e} mm (an exact 0 among them), drawn at it"),
                 (at + 10, 6),
                 font.clone(),
             ))?;
         }
         // The total is at least the facet RMS: never below the floor.
-        FrontRms::Total { .. } => {
-            legend.draw(&Text::new("labels: the knob", (at, 6), font.clone()))?;
-        }
+        FrontRms::Total { .. } => {}
     }
+    legend.draw(&Text::new(knobs_caption(&solvers), (70, 52), font.clone()))?;
     let failures = match failed {
         None => "failed points: not recorded in shards (see each shard's run)".to_string(),
         Some([]) => "no failed point".to_string(),
         Some(failed) => {
             let list: Vec<String> = failed
                 .iter()
-                .map(|(solver, knob)| format!("{solver} at {knob:.0e}"))
+                .map(|(solver, knob)| match solver_kind(solver) {
+                    Some(kind) => format!("{solver} {}", kind.knob_text(&readable(*knob, 3))),
+                    None => format!("{solver} at {}", readable(*knob, 3)),
+                })
                 .collect();
             format!("failed, no design (not drawn): {}", list.join(", "))
         }
@@ -240,6 +243,20 @@ pub fn front_plot(
         rms,
         title
     )
+}
+
+/// A solver by its name in a front's rows.
+fn solver_kind(name: &str) -> Option<SolverKind> {
+    <SolverKind as clap::ValueEnum>::from_str(name, false).ok()
+}
+
+/// What the points' labels are: each solver's knob named, with its unit.
+fn knobs_caption(solvers: &[&str]) -> String {
+    let named: Vec<String> = solvers
+        .iter()
+        .filter_map(|s| Some(format!("{s}: {}", solver_kind(s)?.knob_label()?)))
+        .collect();
+    format!("point labels: each solver's knob — {}", named.join("; "))
 }
 
 /// A knob value as a point's label: one significant digit.
