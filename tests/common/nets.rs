@@ -71,7 +71,11 @@ impl Family {
     /// The `lp` problem of [`Self::network`]: one set of every cable but the
     /// ties, mean tension 50 N, no active bound.
     pub fn problem(self, rings: usize) -> UniformityProblem {
-        let ties = if self == Family::Hex { "hangers" } else { "ties" };
+        let ties = if self == Family::Hex {
+            "hangers"
+        } else {
+            "ties"
+        };
         hexnet::tied_net_problem(self.network(rings), ties, 50.0, 1e9)
     }
 }

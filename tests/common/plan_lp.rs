@@ -109,7 +109,9 @@ pub fn solve_plan(problem: &UniformityProblem, method: &str) -> PlanOptimum {
     let set = &problem.sets()[0].edges;
     let lengths = problem.lengths_m();
     let tensions = set.iter().enumerate().map(|(col, &k)| lengths[k] * x[col]);
-    let (min, max) = tensions.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
+    let (min, max) = tensions.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
+        (lo.min(t), hi.max(t))
+    });
     PlanOptimum {
         ratio: if solution.status == SolverStatus::Solved {
             max / min
