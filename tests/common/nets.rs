@@ -16,15 +16,15 @@
 //!
 //! Every free net node hangs on a vertical tie (1 m) to its own fixed anchor;
 //! the six corners are the fixed net nodes. Groups: `net` (interior), `rim`,
-//! `ties`. Self-contained (only `ringmesh`) so that a bench and an example can
-//! include it with `#[path]`.
+//! `ties`. Needs only `ringmesh` and a sibling module `hexnet`, so that a bench
+//! can include both with `#[path]`.
 #![allow(dead_code)]
 
 use ringmesh::network::Network;
 use ringmesh::uniformity::UniformityProblem;
 
-#[path = "hexnet.rs"]
-mod hexnet;
+// `hexnet.rs`, a sibling module wherever this file is included.
+use super::hexnet;
 
 /// A net family of issue 38.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
