@@ -15,6 +15,16 @@
 //!   F = 4 m, sag 5 %: issue 15's target net), and `100m/<free>` (D = 100 m,
 //!   F/D = 0.4); `RINGMESH_BENCH_FREE=100000` adds ~10⁵-node nets of both
 //!   (20–40 s a solve);
+//! * `lp_families` — the `lp` optimum of the three net families of issue 38
+//!   (`tests/common/nets.rs`: `hex`, the hexagonal generator's 100 m kind;
+//!   `sector`, a six-sector grid with every row sagged, `hex5-lp.json`'s kind;
+//!   `jitter`, that grid graded and jittered ±10 %) at ~10³ and ~10⁴ free
+//!   nodes (`RINGMESH_BENCH_FAMILY_FREE=100000` adds ~10⁵); the id is
+//!   `<family>/<free nodes>`; the plan interior point's iterations are printed;
+//! * `clarabel_plan_lp` — clarabel on the same plan LPs (written from the
+//!   network in `tests/common/plan_lp.rs`), QDLDL and faer backends, ids
+//!   `<backend>/<family>/<free nodes>`, so the ratio to `lp_families` is
+//!   measured in one run (`cargo bench --bench uniformity -- 'lp_families|clarabel_plan_lp'`);
 //! * `gradient_nodes` — the `gradient` solver on the paper scene with 3 rings
 //!   (362 net nodes);
 //! * `gradient_independent` — the `gradient` solver (L-BFGS from afar, then
@@ -40,6 +50,10 @@
 
 #[path = "../tests/common/hexnet.rs"]
 mod hexnet;
+#[path = "../tests/common/nets.rs"]
+mod nets;
+#[path = "../tests/common/plan_lp.rs"]
+mod plan_lp;
 
 use std::path::Path;
 use std::time::Duration;
@@ -166,6 +180,71 @@ fn lp_independent(c: &mut Criterion) {
     group.finish();
 }
 
+/// The problems of `lp_families` and `clarabel_plan_lp`: each family at
+/// ~10³, ~10⁴ and the sizes of `RINGMESH_BENCH_FAMILY_FREE`.
+fn family_problems() -> Vec<(nets::Family, usize, UniformityProblem)> {
+    let mut problems = Vec::new();
+    for free in with_extra(vec![1_000, 10_000], "RINGMESH_BENCH_FAMILY_FREE") {
+        for family in nets::Family::ALL {
+            let p = family.problem(nets::rings_for(free));
+            let n_free = p.structure().free_nodes().len();
+            problems.push((family, n_free, p));
+        }
+    }
+    problems
+}
+
+fn lp_families(c: &mut Criterion) {
+    let mut group = c.benchmark_group("lp_families");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    for (family, free, p) in family_problems() {
+        let id = format!("lp_families/{}/{free}", family.name());
+        if let Ok(d) = Lp.solve(&p) {
+            eprintln!(
+                "{id}: {} interior-point iterations, route {:?}, {:.2} s",
+                d.iterations, d.route, d.time_s
+            );
+        }
+        if p.network().n_nodes() > SAMPLED_MAX_NODES {
+            continue;
+        }
+        group.bench_with_input(BenchmarkId::new(family.name(), free), &p, |b, p| {
+            b.iter(|| Lp.solve(p))
+        });
+    }
+    group.finish();
+}
+
+fn clarabel_plan_lp(c: &mut Criterion) {
+    let mut group = c.benchmark_group("clarabel_plan_lp");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    for (family, free, p) in family_problems() {
+        for backend in ["qdldl", "faer"] {
+            let id = format!("{backend}/{}", family.name());
+            let start = std::time::Instant::now();
+            let once = plan_lp::solve_plan(&p, backend);
+            eprintln!(
+                "clarabel_plan_lp/{id}/{free}: {} iterations, {}, ratio {:.8}, {:.2} s",
+                once.iterations,
+                once.status,
+                once.ratio,
+                start.elapsed().as_secs_f64()
+            );
+            if p.network().n_nodes() > SAMPLED_MAX_NODES {
+                continue;
+            }
+            group.bench_with_input(BenchmarkId::new(id, free), &p, |b, p| {
+                b.iter(|| plan_lp::solve_plan(p, backend))
+            });
+        }
+    }
+    group.finish();
+}
+
 fn gradient_nodes(c: &mut Criterion) {
     let p = problem("paper-26m", Some(3));
     let mut group = c.benchmark_group("gradient_nodes");
@@ -264,6 +343,8 @@ criterion_group!(
     bisection_tolerance,
     lp_nodes,
     lp_independent,
+    lp_families,
+    clarabel_plan_lp,
     gradient_nodes,
     independent,
     smooth_sharpness

@@ -7,6 +7,8 @@
 
 pub mod frames;
 pub mod hexnet;
+pub mod nets;
+pub mod plan_lp;
 
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};

@@ -7,7 +7,7 @@ use super::data::RatioLp;
 use super::direction::Rhs;
 use super::error::IpmError;
 use super::normal::NormalMatrix;
-use super::settings::IpmSettings;
+use super::settings::{IpmSettings, Start};
 use super::status::IpmSolution;
 use crate::algebra::{dot, norm_inf};
 use crate::fdm::NONE;
@@ -88,9 +88,18 @@ impl Program {
         b.iter_mut().for_each(|v| *v = -*v);
 
         // Starting point (Mehrotra): least-norm primal point with Θ = I, Ω = I,
-        // then shifted into the interior together with the dual.
+        // then shifted into the interior together with the dual; with
+        // `Start::TensionScaled` all of it in tensions above the floor
+        // (`ℓ x`, `z/ℓ`): least norm with `Θ = diag(1/ℓ²)`, one shift for
+        // every tension.
+        let tension_scaled = settings.start == Start::TensionScaled;
+        let theta0: Vec<f64> = if tension_scaled {
+            self.lengths.iter().map(|l| 1.0 / (l * l)).collect()
+        } else {
+            vec![1.0; m]
+        };
         let (mut x, mut w, mut s) = {
-            let Ok(sc) = self.scaling(normal, vec![1.0; m], &vec![1.0; p]) else {
+            let Ok(sc) = self.scaling(normal, theta0, &vec![1.0; p]) else {
                 return IpmSolution {
                     q: self.lower.clone(),
                     iterations: 0,
@@ -111,6 +120,10 @@ impl Program {
                 j => self.lengths[k] * lam[j],
             })
             .collect();
+        if tension_scaled {
+            x.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v *= l);
+            z.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v /= l);
+        }
         {
             let min_p = x.iter().chain(&w).fold(f64::INFINITY, |a, &v| a.min(v));
             let min_d = z.iter().chain(&lam).fold(f64::INFINITY, |a, &v| a.min(v));
@@ -125,6 +138,10 @@ impl Program {
             let dd = 0.5 * xz / sum_p;
             x.iter_mut().chain(w.iter_mut()).for_each(|v| *v += dp);
             z.iter_mut().chain(lam.iter_mut()).for_each(|v| *v += dd);
+            if tension_scaled {
+                x.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v /= l);
+                z.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v *= l);
+            }
         }
 
         let mut rp = vec![0.0; n];
@@ -210,7 +227,16 @@ impl Program {
             let rxz: Vec<f64> = x.iter().zip(&z).map(|(a, b)| -a * b).collect();
             let rwl: Vec<f64> = w.iter().zip(&lam).map(|(a, b)| -a * b).collect();
             // Both directions share the factor and differ in the complementarity rows.
-            let mut direction = |rxz: &[f64], rwl: &[f64]| {
+            let zero_n = vec![0.0; n];
+            let zero_m = vec![0.0; m];
+            let zero_p = vec![0.0; p];
+            // `residuals`: the iterate's own residuals, or zero (a corrector).
+            let mut direction = |rxz: &[f64], rwl: &[f64], residuals: bool| {
+                let (rp, rw, rd, rs) = if residuals {
+                    (&rp[..], &rw[..], &rd[..], rs)
+                } else {
+                    (&zero_n[..], &zero_p[..], &zero_m[..], 0.0)
+                };
                 self.direction(
                     normal,
                     &sc,
@@ -219,16 +245,16 @@ impl Program {
                     &w,
                     &lam,
                     &Rhs {
-                        rp: &rp,
-                        rw: &rw,
-                        rd: &rd,
+                        rp,
+                        rw,
+                        rd,
                         rs,
                         rxz,
                         rwl,
                     },
                 )
             };
-            let affine = direction(&rxz, &rwl);
+            let affine = direction(&rxz, &rwl, true);
             let ap = max_step(&x, &affine.dx).min(max_step(&w, &affine.dw));
             let ad = max_step(&z, &affine.dz).min(max_step(&lam, &affine.dlam));
             let mu_aff = ((0..m)
@@ -247,10 +273,59 @@ impl Program {
             let rwl: Vec<f64> = (0..p)
                 .map(|j| sigma * mu - w[j] * lam[j] - affine.dw[j] * affine.dlam[j])
                 .collect();
-            let d = direction(&rxz, &rwl);
+            let mut d = direction(&rxz, &rwl, true);
+            let steps = |d: &super::direction::Direction| {
+                (
+                    max_step(&x, &d.dx).min(max_step(&w, &d.dw)),
+                    max_step(&z, &d.dz).min(max_step(&lam, &d.dlam)),
+                )
+            };
+            // Gondzio's multiple centrality correctors: aim a longer step at
+            // a point whose complementarity products lie within
+            // [β_min, β_max]·σμ, keep the correction while it lengthens the step.
+            let (mut bp, mut bd) = steps(&d);
+            for _ in 0..settings.centrality_correctors {
+                if bp.min(bd) >= 1.0 {
+                    break;
+                }
+                let tp = (1.5 * bp + 0.1).min(1.0);
+                let td = (1.5 * bd + 0.1).min(1.0);
+                let target = sigma * mu;
+                let (lo, hi) = (0.1 * target, 10.0 * target);
+                let push = |v: f64| {
+                    if v < lo {
+                        lo - v
+                    } else if v > hi {
+                        (hi - v).max(-hi)
+                    } else {
+                        0.0
+                    }
+                };
+                let cxz: Vec<f64> = (0..m)
+                    .map(|k| push((x[k] + tp * d.dx[k]) * (z[k] + td * d.dz[k])))
+                    .collect();
+                let cwl: Vec<f64> = (0..p)
+                    .map(|j| push((w[j] + tp * d.dw[j]) * (lam[j] + td * d.dlam[j])))
+                    .collect();
+                let c = direction(&cxz, &cwl, false);
+                let mut trial = super::direction::Direction {
+                    dx: d.dx.iter().zip(&c.dx).map(|(a, b)| a + b).collect(),
+                    dz: d.dz.iter().zip(&c.dz).map(|(a, b)| a + b).collect(),
+                    dw: d.dw.iter().zip(&c.dw).map(|(a, b)| a + b).collect(),
+                    dlam: d.dlam.iter().zip(&c.dlam).map(|(a, b)| a + b).collect(),
+                    dy: d.dy.iter().zip(&c.dy).map(|(a, b)| a + b).collect(),
+                    ds: d.ds + c.ds,
+                };
+                let (np, nd) = steps(&trial);
+                if np.min(nd) < 1.01 * bp.min(bd) {
+                    break;
+                }
+                std::mem::swap(&mut d, &mut trial);
+                (bp, bd) = (np, nd);
+            }
             let eta = (1.0 - mu.min(0.1)).clamp(0.9, 0.99995);
-            let ap = (eta * max_step(&x, &d.dx).min(max_step(&w, &d.dw))).min(1.0);
-            let ad = (eta * max_step(&z, &d.dz).min(max_step(&lam, &d.dlam))).min(1.0);
+            let ap = (eta * bp).min(1.0);
+            let ad = (eta * bd).min(1.0);
             let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
             if !(ap.is_finite()
                 && ad.is_finite()

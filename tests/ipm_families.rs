@@ -1,0 +1,94 @@
+//! The plan interior point on the three net families of issue 38
+//! (`tests/common/nets.rs`: the hexagonal generator, the six-sector grid with
+//! every row sagged, the graded grid jittered ±10 %): each takes the plan
+//! route, reaches clarabel's optimum of the same plan LP to 1e-6 in ratio,
+//! and needs no more interior-point iterations than the bound the method is
+//! held to at every size.
+
+mod common;
+
+use common::nets::{rings_for, Family};
+use common::plan_lp;
+use ringmesh::uniformity::{Lp, Route, UniformitySolver};
+
+/// The plan interior point's result on `family` at `rings` rows against
+/// clarabel's on the same plan LP.
+fn matches_clarabel(family: Family, rings: usize) -> usize {
+    let problem = family.problem(rings);
+    let design = Lp.solve(&problem).expect("lp");
+    assert_eq!(
+        design.route,
+        Some(Route::PlanInteriorPoint),
+        "{}: {:?}",
+        family.name(),
+        design.warnings
+    );
+    assert!(design.warnings.is_empty(), "{:?}", design.warnings);
+    let reference = plan_lp::solve_plan(&problem, "qdldl");
+    assert_eq!(reference.status, "Solved", "{}", family.name());
+    assert!(
+        (design.ratio / reference.ratio - 1.0).abs() <= 1e-6,
+        "{}: {} vs clarabel's {}",
+        family.name(),
+        design.ratio,
+        reference.ratio
+    );
+    design.iterations
+}
+
+#[test]
+fn the_hexagonal_generator_matches_clarabel() {
+    let iterations = matches_clarabel(Family::Hex, 12);
+    assert!(iterations <= 20, "{iterations} iterations");
+}
+
+#[test]
+fn the_sector_grid_matches_clarabel() {
+    let iterations = matches_clarabel(Family::Sector, 12);
+    assert!(iterations <= 20, "{iterations} iterations");
+}
+
+/// Issue 38's target (≤ 20 iterations) is not reached on this family yet:
+/// 30 at 463 free nodes, 33 at 10³ and 64 at 10⁴ (from 42 and 77 with the
+/// unscaled start). The bound holds today's count so that a regression fails.
+#[test]
+fn the_jittered_grid_matches_clarabel() {
+    let iterations = matches_clarabel(Family::Jitter, 12);
+    assert!(iterations <= 32, "{iterations} iterations");
+}
+
+/// The table of issue 38: iterations and ratio per family at the sizes of
+/// `RINGMESH_IPM_FREE` (default 1 000 and 10 000 free nodes). Measurement,
+/// not a check: `cargo test --release --test ipm_families -- --ignored
+/// --nocapture`.
+#[test]
+#[ignore = "measurement: prints a table"]
+fn iteration_table() {
+    let sizes: Vec<usize> = std::env::var("RINGMESH_IPM_FREE")
+        .unwrap_or_else(|_| "1000,10000".into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    for free in sizes {
+        for family in Family::ALL {
+            let rings = rings_for(free);
+            let problem = family.problem(rings);
+            let n_free = problem.structure().free_nodes().len();
+            let design = Lp.solve(&problem).expect("lp");
+            let reference = plan_lp::solve_plan(&problem, "qdldl");
+            eprintln!(
+                "{:>7} {:>7} free {:>3} it  ratio {:.10}  {:?} {:.2} s {:?} | clarabel {} it ratio {:.10} ({:+.1e})",
+                family.name(),
+                n_free,
+                design.iterations,
+                design.ratio,
+                design.route,
+                design.time_s,
+                design.warnings,
+                reference.iterations,
+                reference.ratio,
+                design.ratio / reference.ratio - 1.0
+            );
+        }
+    }
+}
