@@ -8,10 +8,15 @@
 
 use std::path::Path;
 use std::process::Command;
+use std::sync::Mutex;
+
+/// One throw-away cluster at a time.
+static CLUSTER: Mutex<()> = Mutex::new(());
 
 /// Runs the check on `args` (a sweep command and its arguments) in `shards`
 /// array tasks; `None` when Slurm cannot be started here.
 fn slurm_check(shards: usize, args: &[&str]) -> Option<String> {
+    let _one = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let run = Command::new("bash")
         .arg(root.join("scripts/slurm/local-check.sh"))
@@ -52,6 +57,37 @@ fn a_front_sharded_as_a_slurm_job_array_merges_to_the_unsharded_table() {
     assert!(out.contains("COMPLETED"), "{out}");
     assert!(
         out.contains("front.csv: 8 rows equal to the unsharded run"),
+        "{out}"
+    );
+}
+
+#[test]
+fn a_budget_monte_carlo_sharded_as_a_slurm_job_array_merges_to_the_unsharded_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/small-hex.toml"),
+    )
+    .unwrap()
+        + r#"
+[surface]
+frequency_ghz = 8.0
+
+[tolerances]
+cable_length_sigma_m = 5e-6
+rod_length_sigma_m = 2e-5
+hinge_position_sigma_m = 2e-5
+seed = 3
+"#;
+    let scene = dir.path().join("small-hex-budget.toml");
+    std::fs::write(&scene, text).unwrap();
+    let Some(out) = slurm_check(3, &["budget", scene.to_str().unwrap(), "--samples", "8"]) else {
+        return;
+    };
+    // budget.csv (the table) and budget-samples.csv (facets, design and the
+    // 8 samples), value for value.
+    assert!(out.contains("budget.csv: "), "{out}");
+    assert!(
+        out.contains("budget-samples.csv: 10 rows equal to the unsharded run"),
         "{out}"
     );
 }
