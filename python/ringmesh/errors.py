@@ -68,6 +68,10 @@ class SurfaceError(RingmeshError):
     """A surface that cannot be measured, or a net target no net meets."""
 
 
+class BudgetError(RingmeshError):
+    """An error budget that cannot be made (its scene, design or assembly)."""
+
+
 class ReportError(RingmeshError):
     """Reading or writing a file failed."""
 

@@ -87,6 +87,7 @@ fn classify(error: &Error) -> (&'static str, Detail) {
         Error::Shard(_) => ("ShardError", Detail::default()),
         Error::Memory(_) => ("ResourceError", Detail::default()),
         Error::Surface(_) => ("SurfaceError", Detail::default()),
+        Error::Budget(_) => ("BudgetError", Detail::default()),
     }
 }
 
