@@ -56,7 +56,10 @@ fn every_scene_key_has_an_entry_in_the_scene_reference() {
         "[uniformity]\ngroups = [\"front\"]\n\
          [effects]\ntruss = \"exact\"\n\
          [effects.gravity]\nacceleration_m_per_s2 = 9.81\ndirection = [0.0, 0.0, -1.0]\n\
-         [surface]\nrms_mm = 1.5\n",
+         [surface]\nrms_mm = 1.5\n\
+         [tolerances]\ncable_length_sigma_m = 1e-5\n\
+         [effects.thermal]\ncable_expansion_per_k = 1e-6\ntube_expansion_per_k = 1e-6\n\
+         [[effects.thermal.cases]]\nname = \"a\"\n",
     )
     .unwrap();
     full.extend(extra);
@@ -86,6 +89,8 @@ fn every_scene_key_has_an_entry_in_the_scene_reference() {
         "effects.gravity.direction",
         "surface.frequency_ghz",
         "front_net.membrane_stress_n_per_m",
+        "tolerances.seed",
+        "effects.thermal.tie_expansion_per_k",
     ] {
         assert!(seen.contains(key), "{key} not found: {seen:?}");
     }
