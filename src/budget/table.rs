@@ -322,26 +322,20 @@ impl BudgetTable {
             .filter(|r| r.kind == PointKind::Sample)
             .filter_map(|r| r.nonlinear.as_ref().ok().map(|m| (m, linear_of(r))))
             .collect();
-        let failed_cases = rows
-            .iter()
-            .filter(|r| r.kind == PointKind::Thermal)
-            .filter_map(|r| {
-                r.nonlinear
-                    .as_ref()
-                    .err()
-                    .map(|e| format!("{}: {e}", r.name))
-            })
-            .collect();
-        let failed_samples = rows
-            .iter()
-            .filter(|r| r.kind == PointKind::Sample)
-            .filter_map(|r| {
-                r.nonlinear
-                    .as_ref()
-                    .err()
-                    .map(|e| format!("{}: {e}", r.name))
-            })
-            .collect();
+        // "name: why" of each point of `kind` that failed.
+        let failed = |kind: PointKind| -> Vec<String> {
+            rows.iter()
+                .filter(|r| r.kind == kind)
+                .filter_map(|r| {
+                    r.nonlinear
+                        .as_ref()
+                        .err()
+                        .map(|e| format!("{}: {e}", r.name))
+                })
+                .collect()
+        };
+        let failed_cases = failed(PointKind::Thermal);
+        let failed_samples = failed(PointKind::Sample);
         if !samples.is_empty() {
             let column = |f: &dyn Fn(&Measured) -> f64| {
                 samples.iter().map(|(m, _)| f(m)).collect::<Vec<_>>()
