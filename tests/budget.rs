@@ -77,7 +77,8 @@ fn uniform_temperature_with_one_coefficient_scales_the_dish() {
     c.uniform_k = dt;
     let e = effect(&scene, alpha, alpha, vec![c.clone()]);
     let p = thermal(&core, &run, &e, &c);
-    let built: Verification = core.nonlinear(&p).expect("assembles");
+    let tangent = core.linearise().expect("factored");
+    let built: Verification = core.nonlinear(&tangent, &p).expect("assembles");
     let nominal = &core.nominal.verification;
     assert!(built.slack_cables.is_empty());
     // The whole net (and its attachments) is the design as built scaled by
@@ -132,7 +133,7 @@ fn at(
     let p = thermal(core, run, e, &c);
     let tangent = core.linearise().expect("factored");
     let nl = core
-        .change(&core.nonlinear(&p).expect("assembles"))
+        .change(&core.nonlinear(&tangent, &p).expect("assembles"))
         .expect("measured");
     let lin = core
         .change(&core.linear(&tangent, &p).expect("solves"))
@@ -199,7 +200,7 @@ fn samples(
                 kind: PointKind::Sample,
                 name: format!("sample {k}"),
                 nonlinear: core
-                    .nonlinear(&p)
+                    .nonlinear(&tangent, &p)
                     .and_then(|v| core.change(&v))
                     .map_err(|e| e.to_string()),
                 linear: Some(
@@ -223,7 +224,10 @@ fn tolerances_at_zero_sigma_return_the_design_as_built() {
         &run.report.net,
         &scene.cables,
     );
-    let built = core.nonlinear(&model.sample(3, 0)).expect("assembles");
+    let tangent = core.linearise().expect("factored");
+    let built = core
+        .nonlinear(&tangent, &model.sample(3, 0))
+        .expect("assembles");
     assert_eq!(built.rms_mm, core.nominal.verification.rms_mm);
     assert_eq!(
         built.rms_mm, run.report.verification.rms_mm,
@@ -293,6 +297,84 @@ fn monte_carlo_and_linearised_agree_at_small_sigma_and_part_at_large() {
     assert!(
         large > 10.0 * small,
         "no gap at large σ: {large:e} against {small:e}"
+    );
+}
+
+#[test]
+fn chord_iterations_on_the_designs_tangent_find_newtons_equilibrium() {
+    // The budget's nonlinear points are solved by chord iterations with
+    // the design's factored tangent where they converge fast, by Newton
+    // otherwise: both are the perturbed assembly's equilibrium, so where
+    // the chord path converges it must agree with Newton's to the
+    // solver's tolerance, nonlinearity included (σ large enough that the
+    // linearised response is measurably off).
+    let (scene, run) = designed();
+    let core = core(&scene, &run);
+    let tangent = core.linearise().expect("factored");
+    let model = ToleranceModel::new(
+        &tolerances(1e-5, 0.2),
+        &run.mesh,
+        &run.network,
+        &run.report.net,
+        &scene.cables,
+    );
+    let mut chords = 0;
+    for k in 0..6 {
+        let p = model.sample(11, k);
+        let newton = core.newton(&p).expect("Newton assembles");
+        let linear = core.linear(&tangent, &p).expect("solves");
+        let Some(chord) = core
+            .chord(&tangent, &p)
+            .expect("a perturbation of the right size")
+        else {
+            continue;
+        };
+        chords += 1;
+        assert!(
+            chord.newton_iterations >= 2,
+            "one solve is the linear response"
+        );
+        let worst = |v: &Verification| {
+            v.nodes_xyz_m
+                .iter()
+                .zip(&newton.nodes_xyz_m)
+                .map(|(a, b)| distance(*a, *b))
+                .fold(0.0, f64::max)
+        };
+        let shift = core
+            .nominal
+            .verification
+            .nodes_xyz_m
+            .iter()
+            .zip(&newton.nodes_xyz_m)
+            .map(|(a, b)| distance(*a, *b))
+            .fold(0.0, f64::max);
+        let (chord_gap, linear_gap) = (worst(&chord), worst(&linear));
+        // Both stop at forces 1e-12 of the cables' and increments 1e-12 of
+        // the frame's size: equal to that, with room for conditioning.
+        let tolerance = 1e-10 * scene.reflector.aperture_diameter_m;
+        assert!(
+            chord_gap < tolerance,
+            "sample {k}: chord and Newton differ by {chord_gap:e} m (shift {shift:e} m)"
+        );
+        assert!(
+            linear_gap > 100.0 * chord_gap,
+            "sample {k}: the linear response ({linear_gap:e} m off) is as close as the chord \
+             iterations ({chord_gap:e} m): nothing nonlinear was solved"
+        );
+        // A tension is EA times a strain: the positions' tolerance, over a
+        // cable's metre, times EA/T ≈ 1e4–1e5 here.
+        for (t, n) in chord.tensions_n.iter().zip(&newton.tensions_n) {
+            assert!(
+                (t - n).abs() <= 1e-6 * n.abs().max(1.0),
+                "tension {t} N against {n} N"
+            );
+        }
+        assert_eq!(chord.slack_cables, newton.slack_cables, "sample {k}");
+    }
+    assert!(
+        chords >= 4,
+        "the chord iterations converged on {chords} of 6 samples"
     );
 }
 

@@ -115,11 +115,45 @@ impl<'a> PerturbedAssembly<'a> {
     }
 
     /// The assembly with `perturbation`, solved from the design's
-    /// equilibrium.
+    /// equilibrium: by chord iterations with `tangent`
+    /// ([`PerturbedAssembly::linearise`]) where they converge fast, by
+    /// Newton otherwise — the same equilibrium to the solver's tolerance.
     ///
     /// # Errors
     /// No equilibrium, or a perturbation the assembly cannot take.
-    pub fn nonlinear(&self, perturbation: &Perturbation) -> Result<Verification, BudgetError> {
+    pub fn nonlinear(
+        &self,
+        tangent: &Linearised<'_>,
+        perturbation: &Perturbation,
+    ) -> Result<Verification, BudgetError> {
+        match self.chord(tangent, perturbation)? {
+            Some(v) => Ok(v),
+            None => self.newton(perturbation),
+        }
+    }
+
+    /// The assembly with `perturbation` solved by chord iterations with
+    /// `tangent` ([`Linearised::solve`]), `None` where they are slow: the
+    /// first path of [`PerturbedAssembly::nonlinear`].
+    ///
+    /// # Errors
+    /// A perturbation the assembly cannot take.
+    pub fn chord(
+        &self,
+        tangent: &Linearised<'_>,
+        perturbation: &Perturbation,
+    ) -> Result<Option<Verification>, BudgetError> {
+        Ok(tangent.solve(&self.inputs(), perturbation)?)
+    }
+
+    /// The assembly with `perturbation` solved by Newton from the design's
+    /// equilibrium ([`assemble`]), the cut lengths ramped from the design's
+    /// if it does not converge at once: the path of
+    /// [`PerturbedAssembly::nonlinear`] where the chord iterations are slow.
+    ///
+    /// # Errors
+    /// No equilibrium, or a perturbation the assembly cannot take.
+    pub fn newton(&self, perturbation: &Perturbation) -> Result<Verification, BudgetError> {
         let a = assemble(&self.inputs(), Some(&self.nominal.state), perturbation)?;
         Ok(a.verification)
     }

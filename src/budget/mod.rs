@@ -7,9 +7,11 @@
 //! One core serves every source ([`PerturbedAssembly`], `core.rs`): the
 //! design's cut cables assembled on the exact truss once, then each
 //! perturbation ([`crate::verify::Perturbation`]: cable cut lengths and EA,
-//! rod stretches, hinge offsets) assembled from that equilibrium by Newton
-//! (nonlinear) and by one solve with its tangent factored once
-//! (linearised). A thermal case (`thermal.rs`, from
+//! rod stretches, hinge offsets) assembled from that equilibrium —
+//! nonlinear: chord iterations with the design's factored tangent, the
+//! tangent refactored numerically where they slow down (slack cables), and
+//! Newton with load steps where that fails; linearised: one solve with the
+//! same factored tangent. A thermal case (`thermal.rs`, from
 //! [`crate::effects::ThermalExpansion`]) and a tolerance sample
 //! (`tolerances.rs`, seeded per sample) are each one perturbation. Each
 //! source's term is the change it makes to the design's surface as built
@@ -256,7 +258,7 @@ pub fn run(
                     model.sample(settings.seed, s),
                 )
             };
-            let nonlinear = measured(core.nonlinear(&p));
+            let nonlinear = measured(core.nonlinear(&tangent, &p));
             let clock = Instant::now();
             let linear = Some(measured(core.linear(&tangent, &p)));
             let mut spent = linear_time.lock().unwrap_or_else(|e| e.into_inner());

@@ -18,8 +18,8 @@
 
 use std::sync::Arc;
 
+use super::sparse_lu::{Lu, SymbolicLu};
 use faer::linalg::solvers::PartialPivLu;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatMut};
 use rayon::prelude::*;
@@ -45,7 +45,7 @@ const DENSE_ROWS: usize = 64;
 /// A factorisation of the tangent: dense for small systems, sparse otherwise.
 pub(crate) enum Factor {
     Dense(PartialPivLu<f64>),
-    Sparse(Lu<usize, f64>),
+    Sparse(Lu),
     /// The cable net's points condensed onto the frame.
     Condensed(CondensedFactor),
 }
@@ -129,7 +129,7 @@ enum SparseFactorisation {
     /// The cable net's points condensed onto the rest (a model with points).
     Condensed(Arc<Condensation>),
     /// faer's sparse LU of the whole tangent.
-    Lu(SymbolicLu<usize>),
+    Lu(SymbolicLu),
 }
 
 /// The state of the unknowns: node frames and scaled multipliers.
@@ -503,7 +503,7 @@ impl System {
         use faer::linalg::solvers::SolveCore;
         match lu {
             Factor::Dense(lu) => lu.solve_in_place_with_conj(faer::Conj::No, rhs),
-            Factor::Sparse(lu) => lu.solve_in_place_with_conj(faer::Conj::No, rhs),
+            Factor::Sparse(lu) => lu.solve_in_place(rhs),
             Factor::Condensed(factor) => factor.solve_in_place(rhs),
         }
     }

@@ -43,16 +43,15 @@
 
 use std::sync::Arc;
 
+use super::sparse_lu::{Lu, SymbolicLu};
 use crate::algebra::Plain;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
-use faer::linalg::solvers::SolveCore;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, supernodal::SupernodalLdltRef, CholeskySymbolicParams, LdltRef,
     SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, Mat, MatMut, Par, Side};
@@ -142,7 +141,7 @@ pub(crate) struct Condensation {
     m: Block,
     s: Block,
     ldlt: SymbolicCholesky<usize>,
-    lu: Option<SymbolicLu<usize>>,
+    lu: Option<SymbolicLu>,
     par: Par,
 }
 
@@ -153,7 +152,7 @@ pub(crate) struct CondensedFactor {
     l: Vec<f64>,
     /// `Σ`, column-major `m × m`.
     sigma: Mat<f64>,
-    s: Option<Lu<usize, f64>>,
+    s: Option<Lu>,
 }
 
 impl Condensation {
@@ -420,7 +419,7 @@ impl CondensedFactor {
             }
         }
         if let Some(s) = &self.s {
-            s.solve_in_place_with_conj(Conj::No, r.as_mut());
+            s.solve_in_place(r.as_mut());
         }
         // 3. M (δp, w) = (r_p, q + Σ δr)
         let dr = Mat::from_fn(m, k, |c, j| r[(coupled[c], j)]);

@@ -53,6 +53,7 @@ mod path_spec;
 pub mod rotation;
 mod settings;
 mod solver;
+mod sparse_lu;
 mod stability;
 mod statics;
 

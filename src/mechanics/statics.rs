@@ -13,7 +13,7 @@ use super::load_control;
 use super::model::MechanicsError;
 use super::model::Model;
 use super::settings::{PathControl, StaticSettings, StaticSolution};
-use super::solver::StaticSolver;
+use super::solver::{wdot, StaticSolver};
 use super::stability::{self, Stability};
 
 impl StaticSolver {
@@ -138,18 +138,7 @@ impl Linearisation<'_> {
     /// # Errors
     /// A model of another structure, or a non-finite response.
     pub fn respond(&self, changed: &Model) -> Result<State, MechanicsError> {
-        let model = self.solver.model();
-        if changed.node_count() != model.node_count()
-            || changed.elements.len() != model.elements.len()
-            || changed.cables.len() != model.cables.len()
-            || changed.joints.len() != model.joints.len()
-            || changed.fixed != model.fixed
-        {
-            return Err(MechanicsError::invalid(
-                "linearised response",
-                "the changed model has another structure than the linearised one",
-            ));
-        }
+        self.check_structure(changed)?;
         let system = self.solver.system();
         let ev = system.evaluate(changed, &self.state, self.lambda);
         let change: Vec<f64> = ev
@@ -170,4 +159,101 @@ impl Linearisation<'_> {
         system.apply(&mut state, &delta, 1.0);
         Ok(state)
     }
+
+    /// The equilibrium of `changed` (as [`Linearisation::respond`]) solved
+    /// to `settings.tolerance` from `x*`, by chord iterations — Newton's
+    /// with the tangent factored at `x*` kept, `x ← x − J⁻¹ R_changed(x)`;
+    /// the first iterate is the linear response. Each is one residual and
+    /// one solve, no factorisation: near `x*` the error contracts by about
+    /// `‖J⁻¹ (J_changed − J)‖` an iteration. Where an increment does not
+    /// shrink to [`CHORD_CONTRACTION`] of the one before (cables going
+    /// slack change the tangent), the tangent is refactored at the current
+    /// state — numerically only, the symbolic analysis is `x*`'s, the
+    /// structure being the same — and the iterations go on with it, at most
+    /// [`CHORD_REFACTORISATIONS`] times. `None` (the caller follows the
+    /// change by load steps instead) when that does not converge within
+    /// `settings.max_iterations`, or a refactorisation fails; otherwise the
+    /// state and the iterations it took. The state is an equilibrium by the
+    /// solver's own tests ([`StaticSolver::converged`]).
+    ///
+    /// # Errors
+    /// A model of another structure, or invalid settings.
+    pub fn solve(
+        &self,
+        changed: &Model,
+        settings: &StaticSettings,
+    ) -> Result<Option<(State, usize)>, MechanicsError> {
+        settings.validate()?;
+        self.check_structure(changed)?;
+        let system = self.solver.system();
+        let weights = self.solver.weights();
+        let step = |factor: &Factor, residual: &[f64]| {
+            let mut rhs = system.column(residual);
+            System::solve_in_place(factor, rhs.as_mut());
+            let delta: Vec<f64> = (0..system.n_rows).map(|i| -rhs[(i, 0)]).collect();
+            let size = wdot(&weights, &delta, &delta).sqrt();
+            (delta, size)
+        };
+        let mut state = self.state.clone();
+        let mut refreshed: Option<Factor> = None;
+        let mut refactorisations = 0;
+        let mut previous = f64::INFINITY;
+        for iteration in 0..=settings.max_iterations {
+            let ev = system.evaluate(changed, &state, self.lambda);
+            if self.solver.converged(&ev, self.lambda, settings).1 {
+                return Ok(Some((state, iteration)));
+            }
+            if iteration == settings.max_iterations {
+                break;
+            }
+            let (mut delta, mut size) =
+                step(refreshed.as_ref().unwrap_or(&self.factor), &ev.residual);
+            if size.is_nan() || size > CHORD_CONTRACTION * previous {
+                if refactorisations == CHORD_REFACTORISATIONS {
+                    return Ok(None);
+                }
+                let Ok(factor) = system.factor(&ev.values) else {
+                    return Ok(None);
+                };
+                refactorisations += 1;
+                (delta, size) = step(&factor, &ev.residual);
+                refreshed = Some(factor);
+            }
+            if !size.is_finite() {
+                return Ok(None);
+            }
+            system.apply(&mut state, &delta, 1.0);
+            if self.solver.increment_converged(&delta, &weights, settings) {
+                return Ok(Some((state, iteration + 1)));
+            }
+            previous = size;
+        }
+        Ok(None)
+    }
+
+    /// Refuses a model of another structure than the linearised one.
+    fn check_structure(&self, changed: &Model) -> Result<(), MechanicsError> {
+        let model = self.solver.model();
+        if changed.node_count() != model.node_count()
+            || changed.elements.len() != model.elements.len()
+            || changed.cables.len() != model.cables.len()
+            || changed.joints.len() != model.joints.len()
+            || changed.fixed != model.fixed
+        {
+            return Err(MechanicsError::invalid(
+                "linearised response",
+                "the changed model has another structure than the linearised one",
+            ));
+        }
+        Ok(())
+    }
 }
+
+/// Largest ratio of a chord increment to the one before that
+/// [`Linearisation::solve`] accepts: slower, and a step with the tangent
+/// refactored where the iterations are (quadratic, one numeric
+/// factorisation) is the cheaper path.
+pub const CHORD_CONTRACTION: f64 = 0.5;
+
+/// Refactorisations [`Linearisation::solve`] makes before it gives up.
+pub const CHORD_REFACTORISATIONS: usize = 4;

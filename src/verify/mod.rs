@@ -211,20 +211,26 @@ pub struct Assembled {
 }
 
 /// The models of one assembly: the truss (perturbed) and the net's points,
-/// with and without the cables.
+/// and the cables to put on them — built into a model only when a path
+/// asks for it ([`AssemblyModels::cut`] and the ramps), since a budget's
+/// samples mostly need the first alone.
 struct AssemblyModels {
-    /// Truss, points and cables at their cut lengths.
-    cut: ModelBuilder,
-    /// The same with the cables' unstressed lengths ramped from the
-    /// stress-free distance of their ends.
-    ramped: ModelBuilder,
-    /// The same with the cables ramped from the design's cut lengths to the
-    /// perturbed ones (a warm start's path).
-    from_design: ModelBuilder,
     /// Truss and points only.
     bare: ModelBuilder,
+    /// Every cable: its model nodes, EA, the distance of its ends in
+    /// `bare`, its design cut length and its (perturbed) cut length.
+    cables: Vec<CableItem>,
     /// Model node of each net node.
     node_of: Vec<NodeId>,
+}
+
+/// One cable of an assembly ([`AssemblyModels`]).
+struct CableItem {
+    nodes: [NodeId; 2],
+    ea_n: f64,
+    start_m: f64,
+    designed_m: f64,
+    cut_m: f64,
 }
 
 impl AssemblyModels {
@@ -320,41 +326,78 @@ impl AssemblyModels {
                 b.add_load(node_of[i], vector(p), nalgebra::Vector3::zeros());
             }
         }
-        // The truss and the net's points, for the inextensible cables' stages.
-        let bare = b.clone();
         let ea = scene.cables.axial_stiffness_n();
-        let mut ramped = b.clone();
-        let mut from_design = b.clone();
-        for (k, &[i, j]) in network.edges.iter().enumerate() {
-            let (a, c) = (node_of[i], node_of[j]);
-            let start = match (b.frame(a), b.frame(c)) {
-                (Some(fa), Some(fc)) => (fc.position_m - fa.position_m).norm(),
-                _ => 0.0,
-            };
-            let designed = scene
-                .cables
-                .cut_length_m(design.lengths_m[k], design.tensions_n[k]);
-            let cut = match &perturbation.cable_length_factors {
-                Some(f) => designed * f[k],
-                None => designed,
-            };
-            let ea = match &perturbation.cable_stiffness_factors {
-                Some(f) => ea * f[k],
-                None => ea,
-            };
-            b.add_cable(a, c, ea, [cut, cut]);
-            ramped.add_cable(a, c, ea, [start, cut]);
-            from_design.add_cable(a, c, ea, [designed, cut]);
-        }
+        let cables = network
+            .edges
+            .iter()
+            .enumerate()
+            .map(|(k, &[i, j])| {
+                let nodes = [node_of[i], node_of[j]];
+                let start_m = match (b.frame(nodes[0]), b.frame(nodes[1])) {
+                    (Some(fa), Some(fc)) => (fc.position_m - fa.position_m).norm(),
+                    _ => 0.0,
+                };
+                let designed_m = scene
+                    .cables
+                    .cut_length_m(design.lengths_m[k], design.tensions_n[k]);
+                let factor = |f: &Option<Vec<f64>>| f.as_ref().map_or(1.0, |f| f[k]);
+                CableItem {
+                    nodes,
+                    ea_n: ea * factor(&perturbation.cable_stiffness_factors),
+                    start_m,
+                    designed_m,
+                    cut_m: designed_m * factor(&perturbation.cable_length_factors),
+                }
+            })
+            .collect();
         Ok(AssemblyModels {
-            cut: b,
-            ramped,
-            from_design,
-            bare,
+            bare: b,
+            cables,
             node_of,
         })
     }
+
+    /// The truss and points with every cable's unstressed length ramped
+    /// between `ends(cable)` ([`crate::mechanics::Cable`]'s load factors 0
+    /// and 1).
+    fn with_cables(&self, ends: impl Fn(&CableItem) -> [f64; 2]) -> ModelBuilder {
+        let mut b = self.bare.clone();
+        for c in &self.cables {
+            b.add_cable(c.nodes[0], c.nodes[1], c.ea_n, ends(c));
+        }
+        b
+    }
+
+    /// Truss, points and cables at their cut lengths.
+    fn cut(&self) -> ModelBuilder {
+        self.with_cables(|c| [c.cut_m, c.cut_m])
+    }
+
+    /// The same with the cables' unstressed lengths ramped from the
+    /// stress-free distance of their ends.
+    fn ramped(&self) -> ModelBuilder {
+        self.with_cables(|c| [c.start_m, c.cut_m])
+    }
+
+    /// The same with the cables ramped from the design's cut lengths to the
+    /// perturbed ones (a warm start's path).
+    fn ramped_from_design(&self) -> ModelBuilder {
+        self.with_cables(|c| [c.designed_m, c.cut_m])
+    }
 }
+
+/// The static solver's settings of every assembly: forces balanced to 1e-12
+/// of the cables' (the net's tolerance is far below the truss's).
+fn assembly_settings() -> StaticSettings {
+    StaticSettings {
+        tolerance: 1e-12,
+        ..StaticSettings::default()
+    }
+}
+
+/// Chord iterations a perturbed assembly is given from its design's
+/// tangent ([`Linearised::solve`]) before Newton takes over.
+const CHORD_ITERATIONS: usize = 20;
 
 /// Assemble `inputs`' design, as built with `perturbation`, and solve.
 ///
@@ -402,25 +445,16 @@ pub fn assemble(
         ));
     }
     let layout = &mesh.truss;
-    let AssemblyModels {
-        cut: b,
-        ramped,
-        from_design,
-        bare,
-        node_of,
-    } = AssemblyModels::new(inputs, perturbation)?;
+    let models = AssemblyModels::new(inputs, perturbation)?;
     let ea = scene.cables.axial_stiffness_n();
-    let settings = StaticSettings {
-        tolerance: 1e-12,
-        ..StaticSettings::default()
-    };
+    let settings = assembly_settings();
     // First from the truss as the design's pull deforms it (the equilibrium
     // sought is near: Newton from the undeformed truss can diverge, the hinge
     // motion being many times the cables' elastic stretch); then, if that
     // fails, from the undeformed truss with the prestrain ramped in load steps.
     let mut found = None;
     // A whole assembly's state, or the truss's alone?
-    let whole = start.is_some_and(|e| e.state.frames.len() == b.node_count());
+    let whole = start.is_some_and(|e| e.state.frames.len() == models.bare.node_count());
     let guess = match (frame, start) {
         (None, Some(e)) if whole => Some(Cow::Borrowed(e)),
         (None, _) => None,
@@ -436,7 +470,7 @@ pub fn assemble(
         start
     };
     if let Some(guess) = &guess {
-        let solver = StaticSolver::new(b.build()?)?;
+        let solver = StaticSolver::new(models.cut().build()?)?;
         let start = start_of(&solver, guess);
         // One Newton solve, no step cuts, a few iterations: from a good
         // guess it converges at once; otherwise the ramp below is the
@@ -452,7 +486,7 @@ pub fn assemble(
         } else if whole && !perturbation.is_none() {
             // A perturbed assembly from the design's: its cut lengths
             // ramped from the design's, in load steps.
-            let solver = StaticSolver::new(from_design.build()?)?;
+            let solver = StaticSolver::new(models.ramped_from_design().build()?)?;
             let start = start_of(&solver, guess);
             let s = solver.solve_from(start, 0.0, &settings)?;
             // At load factor 1 its model is the perturbed assembly's. If it
@@ -466,7 +500,7 @@ pub fn assemble(
     let (solver, solution) = match found {
         Some(found) => found,
         None => {
-            let solver = StaticSolver::new(ramped.build()?)?;
+            let solver = StaticSolver::new(models.ramped().build()?)?;
             let s = solver.solve(&settings)?;
             (solver, s)
         }
@@ -490,12 +524,12 @@ pub fn assemble(
                 .enumerate()
                 .map(|(k, _)| [design.lengths_m[k], design.tensions_n[k]])
                 .collect();
-            stiffening::stiffen(&bare, &targets, ea, solver, solution, &settings)?
+            stiffening::stiffen(&models.bare, &targets, ea, solver, solution, &settings)?
         }
     };
     let mut verification = measure(
         inputs,
-        &node_of,
+        &models.node_of,
         solver.model(),
         &solution.state.frames,
         cable_model,
@@ -547,12 +581,45 @@ impl Linearised<'_> {
     ) -> Result<Verification, VerifyError> {
         let clock = Instant::now();
         let models = AssemblyModels::new(inputs, perturbation)?;
-        let model = models.cut.build()?;
+        let model = models.cut().build()?;
         let state = self.tangent.respond(&model)?;
         let cable_model = inputs.effects.cable_model();
         let mut v = measure(inputs, &models.node_of, &model, &state.frames, cable_model)?;
         v.time_s = clock.elapsed().as_secs_f64();
         Ok(v)
+    }
+
+    /// The assembly of `inputs` as built with `perturbation`, solved
+    /// (nonlinear, to [`assemble`]'s tolerance) by chord iterations with the
+    /// factored tangent ([`Linearisation::solve`]): no factorisation, so a
+    /// small perturbation costs a few residuals and solves. `None` where
+    /// they do not converge fast — [`assemble`] from the design's state is
+    /// then the path. Its `newton_iterations` are the chord iterations,
+    /// `load_steps` 1.
+    ///
+    /// # Errors
+    /// A perturbation of the wrong size or one the assembly cannot take.
+    pub fn solve(
+        &self,
+        inputs: &AssemblyInputs<'_>,
+        perturbation: &Perturbation,
+    ) -> Result<Option<Verification>, VerifyError> {
+        let clock = Instant::now();
+        let models = AssemblyModels::new(inputs, perturbation)?;
+        let model = models.cut().build()?;
+        let settings = StaticSettings {
+            max_iterations: CHORD_ITERATIONS,
+            ..assembly_settings()
+        };
+        let Some((state, iterations)) = self.tangent.solve(&model, &settings)? else {
+            return Ok(None);
+        };
+        let cable_model = inputs.effects.cable_model();
+        let mut v = measure(inputs, &models.node_of, &model, &state.frames, cable_model)?;
+        v.newton_iterations = iterations;
+        v.load_steps = 1;
+        v.time_s = clock.elapsed().as_secs_f64();
+        Ok(Some(v))
     }
 }
 
