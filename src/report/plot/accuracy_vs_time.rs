@@ -211,7 +211,7 @@ where
     Ok(())
 }
 
-fn draw_study<DB: DrawingBackend>(
+pub(super) fn draw_study<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     rows: &[StudyRow],
     rms: &StudyRms,

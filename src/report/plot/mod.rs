@@ -12,6 +12,8 @@ mod canvas;
 mod convergence;
 mod frame_path;
 mod front;
+#[cfg(test)]
+mod label_check;
 mod labels;
 mod sizing;
 mod strategies;

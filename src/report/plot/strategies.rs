@@ -105,7 +105,24 @@ fn marker_at<DB: DrawingBackend, C>(solver: SolverKind, at: C, hollow: bool) -> 
         + PathElement::new(closed, c.stroke_width(2))
 }
 
-fn draw_strategies<DB: DrawingBackend>(
+/// Ticks of a logarithmic time axis from `lo` to `hi`, s: 1, 2 and 5 of
+/// each decade (1 alone over more than three decades), each once (plotters'
+/// own key points list a decade's end twice when the axis spans less than
+/// one).
+fn time_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let steps: &[f64] = if last - first > 3 {
+        &[1.0]
+    } else {
+        &[1.0, 2.0, 5.0]
+    };
+    (first..=last)
+        .flat_map(|k| steps.iter().map(move |m| m * 10f64.powi(k)))
+        .filter(|v| (lo..=hi).contains(v))
+        .collect()
+}
+
+pub(super) fn draw_strategies<DB: DrawingBackend>(
     root: Area<DB>,
     rows: &[StudyRow],
     rms: &StudyRms,
@@ -139,7 +156,12 @@ where
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())?;
+        .build_cartesian_2d(
+            (x_lo..x_hi)
+                .log_scale()
+                .with_key_points(time_ticks(x_lo, x_hi)),
+            (y_lo..y_hi).log_scale(),
+        )?;
     chart
         .configure_mesh()
         .x_desc("wall time of the design (s)")
