@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use ringmesh::design::DesignSettings;
 use ringmesh::geometry::build_mesh;
-use ringmesh::report::{FrontRms, FrontRow, RmsAxis, StudyRms};
+use ringmesh::report::{strategy_series, FrontRms, FrontRow, RmsAxis, StudyRms};
 use ringmesh::run::{self, Silent, StudyOptions};
 use ringmesh::scene::TrussModel;
 use ringmesh::study::Knob;
@@ -108,6 +108,7 @@ fn every_plot_is_drawn_for_every_shipped_scene() {
             study.rows
         );
         assert_drawn(out.path(), run::STUDY_STEM, &scene);
+        assert_drawn(out.path(), run::STRATEGIES_STEM, &scene);
 
         // The design's plots, for the scenes no other test designs.
         if scene.starts_with(dir.path()) {
@@ -123,6 +124,45 @@ fn every_plot_is_drawn_for_every_shipped_scene() {
             assert!(std::fs::metadata(&png).unwrap().len() > 1000, "{name}");
         }
     }
+}
+
+/// The study's strategies figure: one series per solver the study ran —
+/// every solver here —, each in the legend of the figure written, which
+/// says how a zero RMS is drawn.
+#[test]
+fn the_strategies_figure_draws_one_series_per_solver_run() {
+    let out = tempfile::tempdir().unwrap();
+    let scene = common::problem("small-hex.toml");
+    let options = StudyOptions {
+        knobs: vec![Knob::Solver],
+        solvers: Some(SolverKind::ALL.to_vec()),
+        ..StudyOptions::default()
+    };
+    let study = run::study(&scene, &options, Some(out.path()), None, &Silent).unwrap();
+    assert_drawn(out.path(), run::STRATEGIES_STEM, &scene);
+    let rows: Vec<_> = study.rows.iter().map(|(_, r)| r.clone()).collect();
+    let run: Vec<SolverKind> = rows
+        .iter()
+        .filter(|r| r.knob == Knob::Solver)
+        .map(|r| r.settings.solver)
+        .collect();
+    assert_eq!(run, SolverKind::ALL);
+    let series = strategy_series(&rows);
+    assert_eq!(series.len(), run.len());
+    for (s, solver) in series.iter().zip(&run) {
+        assert_eq!(s.solver, *solver);
+        assert_eq!(s.rows.len(), 1, "{solver:?}");
+    }
+    let svg = std::fs::read_to_string(out.path().join("strategies.svg")).unwrap();
+    for solver in &run {
+        assert!(
+            svg.contains(&format!(">\n{}\n</text>", solver.name())),
+            "{solver:?} has no legend entry"
+        );
+    }
+    assert!(svg.contains("an exact 0 among them"), "no zero convention");
+    // A study without the solver knob draws no series and says why.
+    assert!(strategy_series(&rows[..1]).is_empty());
 }
 
 /// The facet RMS of the design surface of small-hex's net with `rings`

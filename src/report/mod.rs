@@ -25,8 +25,9 @@ pub use output_path::OutputPath;
 pub use output_set::{check_manifest, FileRecord, OutputSet, RunRecord, WithRun};
 pub use pending::abandon_all_and_exit;
 pub use plot::{
-    aperture_plot, budget_plot, convergence_plot, front_plot, path_plot, sizing_plot, study_plot,
-    surface_plot, total_rms_mm, FrontRms, PanelContent, PanelRms, PathFigure, RmsAxis, StudyRms,
-    SurfaceFigure, SurfacePanel,
+    aperture_plot, budget_plot, convergence_plot, front_plot, path_plot, sizing_plot,
+    strategies_plot, strategy_series, study_plot, surface_plot, total_rms_mm, FrontRms,
+    PanelContent, PanelRms, PathFigure, RmsAxis, StrategySeries, StudyRms, SurfaceFigure,
+    SurfacePanel,
 };
 pub use vtk::{assembly_vtu, network_vtu};

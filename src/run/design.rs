@@ -406,7 +406,9 @@ fn write_design(
         &path("model.vtu"),
         assembly_vtu(
             network,
-            &report.net.q,
+            mesh,
+            &report.net,
+            &scene.cables,
             &report.verification,
             report.limit_margin.as_ref().map(|m| &m.mode),
         )

@@ -46,7 +46,7 @@ pub use merge::{merge, MergeOutcome, MergedTable};
 pub use mesh::{mesh, MeshOutcome};
 pub use optimize::{optimize, OptimizeOutcome};
 pub use size::{section_line, size, SizeOutcome};
-pub use study::{study, study_rows, StudyOptions, StudyOutcome, STUDY_STEM};
+pub use study::{study, study_rows, StudyOptions, StudyOutcome, STRATEGIES_STEM, STUDY_STEM};
 pub use truss::{truss, TrussOutcome};
 pub use uniformity::{uniformity, uniformity_of, UniformityOutcome, UniformityOutput};
 

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
 use crate::geometry::build_mesh;
 use crate::report::{
-    decimal, readable, study_csv, study_plot, study_row, write_atomic, OutputSet, RmsAxis,
-    StudyRms, STUDY_COLUMNS,
+    decimal, readable, strategies_plot, study_csv, study_plot, study_row, write_atomic, OutputSet,
+    RmsAxis, StudyRms, STUDY_COLUMNS,
 };
 use crate::resources::{check_scene_jobs, SceneCommand};
 use crate::scene::{Scene, TrussModel};
@@ -220,7 +220,8 @@ pub const STUDY_STEM: &str = stem!();
 
 /// `ringmesh study`: what accuracy costs in time ([`crate::study`]). Writes
 /// `accuracy-vs-time.csv`, `.png` and `.svg` (drawn against the surface RMS
-/// `options.rms` chooses); with a `shard`, only that
+/// `options.rms` chooses) and `strategies.png`, `.svg` (every solver's time
+/// against its accuracy); with a `shard`, only that
 /// shard's points (and the reference, run to judge them), written as
 /// `accuracy-vs-time.shard-I-of-N.csv`.
 pub fn study(
@@ -320,16 +321,31 @@ fn design_surface_facets_by_rings(
         .collect()
 }
 
-/// The files of a whole study (stem [`STUDY_STEM`]).
-pub(crate) const FILES: [&str; 3] = [
+/// The strategies figure's file stem, as a literal (for [`FILES`]).
+macro_rules! strategies_stem {
+    () => {
+        "strategies"
+    };
+}
+
+/// The name of the strategies figure (every solver's time against its
+/// accuracy), written beside the study's table.
+pub const STRATEGIES_STEM: &str = strategies_stem!();
+
+/// The files of a whole study (stem [`STUDY_STEM`], and the strategies
+/// figure [`STRATEGIES_STEM`]).
+pub(crate) const FILES: [&str; 5] = [
     concat!(stem!(), ".csv"),
     concat!(stem!(), ".png"),
     concat!(stem!(), ".svg"),
+    concat!(strategies_stem!(), ".png"),
+    concat!(strategies_stem!(), ".svg"),
 ];
 
 /// `accuracy-vs-time.csv` (the table `csv`), `.png`, `.svg` (drawn from
-/// `rows` against `rms`), written into `set` (begun with [`FILES`]) and
-/// swapped in.
+/// `rows` against `rms`) and `strategies.png`, `.svg` (the solver knob's
+/// rows: every solver's time against its accuracy), written into `set`
+/// (begun with [`FILES`]) and swapped in.
 pub(crate) fn write_study(
     set: OutputSet,
     scene: &str,
@@ -337,10 +353,14 @@ pub(crate) fn write_study(
     rms: &StudyRms,
     csv: &str,
 ) -> Result<Vec<PathBuf>, Error> {
-    let [csv_path, png, svg] = FILES.map(|name| set.path(name));
+    let [csv_path, png, svg, strategies_png, strategies_svg] = FILES.map(|name| set.path(name));
     let title =
         format!("{scene}: what accuracy costs in time (designs as built on the reference truss)");
     study_plot(rows, rms, &title, &png, &svg)?;
+    let title = format!(
+        "{scene}: each solver's time against its accuracy (designs as built on the reference truss)"
+    );
+    strategies_plot(rows, rms, &title, &strategies_png, &strategies_svg)?;
     write_atomic(&csv_path, csv.as_bytes())?;
     set.seal()?;
     Ok(set.commit()?)

@@ -41,7 +41,7 @@ impl StudyRms {
     }
 
     /// The axis's caption.
-    fn caption(&self) -> &'static str {
+    pub(super) fn caption(&self) -> &'static str {
         match self {
             StudyRms::Design => "surface RMS as built on the reference truss (mm)",
             StudyRms::Total { .. } => {
@@ -211,7 +211,7 @@ where
     Ok(())
 }
 
-fn draw_study<DB: DrawingBackend>(
+pub(super) fn draw_study<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     rows: &[StudyRow],
     rms: &StudyRms,

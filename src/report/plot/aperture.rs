@@ -81,7 +81,7 @@ fn aperture_models() -> [(TrussModel, &'static str, RGBAColor); 3] {
     ]
 }
 
-fn draw_apertures<DB: DrawingBackend>(
+pub(super) fn draw_apertures<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     results: &[ApertureResult],
     title: &str,

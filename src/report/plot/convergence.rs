@@ -11,7 +11,7 @@ use crate::report::{DrawError, ReportError};
 /// Floor of a logarithmic residual axis, m.
 const RESIDUAL_FLOOR_M: f64 = 1e-12;
 
-fn draw_convergence<DB: DrawingBackend>(
+pub(super) fn draw_convergence<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     series: &[(String, Vec<(usize, f64)>)],
     title: &str,

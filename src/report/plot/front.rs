@@ -49,7 +49,7 @@ impl FrontRms {
     }
 }
 
-fn draw_front<DB: DrawingBackend>(
+pub(super) fn draw_front<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     points: &[FrontRow],
     failed: Option<&[(String, f64)]>,

@@ -1,7 +1,7 @@
 //! Pictures (plotters), one figure a file: the design front, the outer
-//! loop's convergence, the surface error, the accuracy study, the aperture
-//! study, the truss sizing and a frame's equilibrium path. What they share — the font shipped
-//! in the crate (plots render on a machine without system fonts), the
+//! loop's convergence, the surface error, the accuracy study and its
+//! solvers' strategies, the aperture study, the truss sizing and a frame's
+//! equilibrium path. What they share — the font shipped in the crate (plots render on a machine without system fonts), the
 //! drawing areas and the writing of PNG and SVG — is in `canvas`; point
 //! labels in `labels`.
 
@@ -12,8 +12,11 @@ mod canvas;
 mod convergence;
 mod frame_path;
 mod front;
+#[cfg(test)]
+mod label_check;
 mod labels;
 mod sizing;
+mod strategies;
 mod surface_error;
 
 pub use accuracy_vs_time::{study_plot, StudyRms};
@@ -23,6 +26,7 @@ pub use convergence::convergence_plot;
 pub use frame_path::{path_plot, PathFigure};
 pub use front::{front_plot, FrontRms};
 pub use sizing::sizing_plot;
+pub use strategies::{strategies_plot, strategy_series, StrategySeries};
 pub use surface_error::{surface_plot, PanelContent, PanelRms, SurfaceFigure, SurfacePanel};
 
 /// Floor for a logarithmic RMS axis, mm (an exact design has RMS ≈ 1e-12 mm).

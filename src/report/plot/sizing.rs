@@ -20,7 +20,7 @@ fn section_label(t: &SectionTrial) -> String {
     )
 }
 
-fn draw_sizing<DB: DrawingBackend>(
+pub(super) fn draw_sizing<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     trials: &[SectionTrial],
     chosen: usize,

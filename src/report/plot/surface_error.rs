@@ -392,7 +392,7 @@ fn rows(figure: &SurfaceFigure) -> Vec<Vec<&SurfacePanel>> {
 
 /// The figure's size, px: the longest row's panels side by side, the rows
 /// one above the other, the title above and the colour bar to the right.
-fn figure_size(figure: &SurfaceFigure) -> (u32, u32) {
+pub(super) fn figure_size(figure: &SurfaceFigure) -> (u32, u32) {
     let rows = rows(figure);
     let columns = rows.iter().map(Vec::len).max().unwrap_or(1) as u32;
     (
@@ -401,7 +401,7 @@ fn figure_size(figure: &SurfaceFigure) -> (u32, u32) {
     )
 }
 
-fn draw_surface<DB: DrawingBackend>(
+pub(super) fn draw_surface<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     figure: &SurfaceFigure,
 ) -> Result<(), DrawError>
