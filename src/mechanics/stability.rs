@@ -335,21 +335,28 @@ enum Source {
 /// congruent to `J`, so of exactly its inertia (Sylvester) for any `ρ`
 /// (the augmented Lagrangian: `H + ρAᵀA` is `H` on `ker A`). With
 /// `ρ = 1/s` (`s` the constraint scale, [`super::assembly`]) the penalty
-/// `s GᵀG` is as stiff as the stiffest element, and `H + ρAᵀA` is positive
-/// definite wherever the frame is stable; the joint nodes' blocks it fills
+/// `s GᵀG` is as stiff as the stiffest element: enough, in practice, for
+/// `H + ρAᵀA` to be positive definite wherever the frame is stable (it is
+/// for `ρ` large enough, Finsler; a rod or body that only joints hold has
+/// its rigid motions stiffened by it). The joint nodes' blocks it fills
 /// are in the tangent's pattern already. The order eliminates `H`'s
 /// unknowns by approximate minimum degree, each multiplier right after the
 /// last of its joint's unknowns: every leading block is then the saddle
 /// point of a part of the frame with the later unknowns clamped, which is
 /// nonsingular when `H + ρAᵀA` is definite (its principal blocks are, and
-/// `A`'s rows stay independent), so no pivot is zero on a stable state.
-/// Past a critical point the count stays exact while no pivot is; faer's
-/// supernodal `LBLᵀ` pivots by Bunch–Kaufman inside each supernode,
-/// against small pivots there.
+/// `A`'s rows stay independent), so that no pivot is zero on a stable
+/// state. Past a critical point the count stays exact while no pivot is;
+/// faer's supernodal `LBLᵀ` pivots by Bunch–Kaufman inside each supernode,
+/// against small pivots there. A pivot that is not finite (a zero one
+/// met) leaves the count out (`None`), not wrong.
 ///
 /// Measured against the dense count ([`dense_negative_eigenvalues`], the
-/// tests below and `tests/critical_points.rs`): the same count at every
-/// point of the paths, through and past the bifurcations.
+/// tests below): the same count at every point of load sweeps through the
+/// column's two Euler loads, the Argyris frame's two bifurcations and the
+/// ring truss's double one (bodies held by revolute and fixed joints only).
+/// At 1 038 rows (the ring truss) it takes 4 ms where the dense count takes
+/// 30–55 ms and the inverse iteration of [`lowest_eigenpair`] 5 ms: one
+/// symbolic analysis per model, one numeric factorisation per count.
 ///
 /// Rejected: a penalty form `H + ρAᵀA` alone (no multipliers) counts
 /// `H`'s negative eigenvalues on `ker A` only for `ρ` large against
