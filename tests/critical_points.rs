@@ -13,6 +13,14 @@
 //!   bifurcation, and the count of negative eigenvalues stays 1 from it to
 //!   the end (the count is checked against an independent eigenvalue count
 //!   in the unit tests of `mechanics::stability`).
+//!
+//! Item 11's own case is a planar portal frame of tubes (equal bending
+//! stiffness in and out of its plane) whose columns buckle out of plane,
+//! followed by arc length past that buckling: past it, the least-magnitude
+//! eigenvalue switches from the negative out-of-plane mode to the positive
+//! in-plane sway mode (their magnitudes cross), a sign change the
+//! least-eigenvalue test read as a crossing. Meshed finely, its tangent has
+//! more rows than the dense count takes: the sparse count sees it through.
 
 mod common;
 
@@ -200,4 +208,137 @@ fn an_exit_3_names_the_target_not_reached() {
             && !stderr.contains("full load"),
         "{stderr}"
     );
+}
+
+/// A portal frame in the x–y plane: two columns of 4 m clamped at their
+/// feet, a beam of 4 m fixed to their tops, every rod a 24/22 mm tube
+/// (E = 160 GPa, G = 60 GPa: bending stiffness 766 N·m² about both axes,
+/// torsion 574.6 N·m²) of `elements` elements, 100 N down on each top
+/// corner, followed by arc length to the load factor `target`.
+///
+/// The columns buckle out of plane first, together (the beam translating
+/// and turning about its own axis, so restraining nothing): each a
+/// cantilever, `P = π²EI/(4H²)` = 118.13 N, by shear `1/(1/P + 1/GA)`
+/// = 118.12 N. In plane they sway with the beam restraining their tops,
+/// above 3 × 100 N.
+fn portal(elements: usize, target: f64) -> String {
+    format!(
+        r#"
+nodes = [
+  {{ name = "a", position_m = [0.0, 0.0, 0.0] }},
+  {{ name = "b", position_m = [0.0, 4.0, 0.0] }},
+  {{ name = "c", position_m = [4.0, 4.0, 0.0] }},
+  {{ name = "d", position_m = [4.0, 0.0, 0.0] }},
+]
+
+[sections.tube]
+axial_n = 1.156e7
+shear_n = [2.2e6, 2.2e6]
+torsion_nm2 = 574.6
+bending_nm2 = [766.0, 766.0]
+
+[[rods]]
+name = "left"
+start = "a"
+end = "b"
+section = "tube"
+elements = {elements}
+up = [0.0, 0.0, 1.0]
+[[rods]]
+name = "beam"
+start = "b"
+end = "c"
+section = "tube"
+elements = {elements}
+up = [0.0, 0.0, 1.0]
+[[rods]]
+name = "right"
+start = "d"
+end = "c"
+section = "tube"
+elements = {elements}
+up = [0.0, 0.0, 1.0]
+
+[[joints]]
+kind = "fixed"
+a = {{ rod = "left", end = "end" }}
+b = {{ rod = "beam", end = "start" }}
+[[joints]]
+kind = "fixed"
+a = {{ rod = "beam", end = "end" }}
+b = {{ rod = "right", end = "end" }}
+
+[[supports]]
+on = {{ rod = "left", end = "start" }}
+fixed = ["all"]
+[[supports]]
+on = {{ rod = "right", end = "start" }}
+fixed = ["all"]
+
+[[loads]]
+on = {{ rod = "beam", end = "start" }}
+force_n = [0.0, -100.0, 0.0]
+[[loads]]
+on = {{ rod = "beam", end = "end" }}
+force_n = [0.0, -100.0, 0.0]
+
+[solver]
+path = "arc_length"
+max_step = 0.05
+
+[path]
+target = {{ load_factor = {target:?} }}
+
+[output]
+nodes = [{{ rod = "beam", end = "start" }}]
+"#
+    )
+}
+
+/// Issue 40 item 11: past the out-of-plane buckling the least eigenvalue
+/// switches modes, and exactly one bifurcation is reported, the inertia 1
+/// from it to the end.
+#[test]
+fn a_portal_with_equal_bending_stiffnesses_reports_only_its_real_bifurcation() {
+    // 60 elements per rod: 183 nodes, 1 098 unknowns and 12 multipliers
+    // less 12 fixed components = 1 098 rows, above the dense count's 1 000.
+    let path = follow(&portal(60, 3.0));
+    assert_eq!(path.solution.termination, StaticTermination::Converged);
+    let found = bifurcations(&path);
+    assert_eq!(found.len(), 1, "{:?}", path.critical_points);
+    assert_eq!(path.critical_points.len(), 1, "{:?}", path.critical_points);
+    // The continuum load, the element converging at second order: 9.2e-4,
+    // 2.4e-4, 6.7e-5 above it at 15, 30 and 60 elements per rod.
+    let euler = std::f64::consts::PI.powi(2) * 766.0 / (4.0 * 4.0 * 4.0);
+    let continuum = 1.0 / (1.0 / euler + 1.0 / 2.2e6);
+    let located = 100.0 * found[0];
+    assert!(
+        (located - continuum).abs() <= 1e-4 * continuum,
+        "located {located} N, continuum {continuum} N"
+    );
+    // The inertia: 0 before, exactly 1 from the buckling to the end.
+    for p in &path.points {
+        let expected = usize::from(p.load_factor > found[0]);
+        assert_eq!(
+            p.negative_eigenvalues,
+            Some(expected),
+            "λ = {}",
+            p.load_factor
+        );
+    }
+    assert_eq!(path.final_negative_eigenvalues, Some(1));
+    // The case is item 11's: after the buckling, the least-magnitude
+    // eigenvalue changes sign again between two steps (from the negative
+    // out-of-plane mode to the positive in-plane one) with no crossing.
+    let after: Vec<f64> = path
+        .points
+        .iter()
+        .filter(|p| p.load_factor > found[0])
+        .map(|p| p.lowest_stiffness_n_per_m.unwrap())
+        .collect();
+    let switches = after
+        .windows(2)
+        .filter(|w| w[0] < 0.0 && w[1] > 0.0)
+        .count();
+    assert_eq!(switches, 1, "{after:?}");
 }

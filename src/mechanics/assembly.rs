@@ -122,6 +122,10 @@ pub(crate) struct System {
     argsort: Argsort<usize>,
     /// How the tangent is factored above [`DENSE_ROWS`].
     sparse: SparseFactorisation,
+    /// The structure of the sparse inertia count, analysed at its first
+    /// use ([`super::stability::negative_eigenvalues`]); `None` inside when
+    /// it could not be.
+    pub(crate) inertia: std::sync::OnceLock<Option<super::stability::InertiaStructure>>,
 }
 
 /// The symbolic factorisation of a sparse tangent.
@@ -307,6 +311,7 @@ impl System {
             symbolic,
             argsort,
             sparse,
+            inertia: std::sync::OnceLock::new(),
         })
     }
 
@@ -496,6 +501,15 @@ impl System {
             dense[(p.row, p.col)] += v;
         }
         dense
+    }
+
+    /// The tangent with `values` (pattern order) as a sparse matrix
+    /// (duplicates summed; the pattern is structurally symmetric).
+    pub(crate) fn sparse_tangent(
+        &self,
+        values: &[f64],
+    ) -> Result<SparseColMat<usize, f64>, faer::sparse::FaerError> {
+        SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
     }
 
     /// Solve `J Δ = rhs` in place with a factor of the tangent.

@@ -17,10 +17,12 @@
 //!   ([`super::stability::lowest_eigenpair`]) signed by the inertia, so
 //!   that a switch of the least eigenvalue between two modes of opposite
 //!   signs, the inertia unchanged, is no crossing, and near the crossing
-//!   the least eigenvalue is the crossing one. Where the inertia is not
-//!   counted (a tangent above [`super::stability::INERTIA_ROWS`] rows) the
-//!   least eigenvalue's own sign change is the test, and one that does not
-//!   shrink towards zero as the fraction closes in is dropped;
+//!   the least eigenvalue is the crossing one. Every symmetric tangent has
+//!   its inertia counted, whatever its size (dense or sparse); where it is
+//!   not — an unsymmetric tangent (a moment fixed in space: no energy, no
+//!   inertia to count), or a factorisation that met a pivot not finite —
+//!   the least eigenvalue's own sign change is the test, and one that does
+//!   not shrink towards zero as the fraction closes in is dropped;
 //! * the target: the load factor or a node's displacement minus its value.
 //!
 //! At a bifurcation the path may leave for the other branch: one arc-length

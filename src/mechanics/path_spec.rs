@@ -56,7 +56,7 @@ pub struct PathPoint {
     pub lowest_stiffness_n_per_m: Option<f64>,
     /// How many eigenvalues of that stiffness are negative (the tangent's
     /// inertia: 0 on a stable branch); `None` without the stability test
-    /// or for a tangent too large to count (above 1 000 rows).
+    /// or for an unsymmetric tangent (loads that are not conservative).
     pub negative_eigenvalues: Option<usize>,
     /// Newton iterations of the step that reached it.
     pub iterations: usize,

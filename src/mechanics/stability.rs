@@ -21,16 +21,27 @@
 //! structure, `J` has exactly `m` more negative eigenvalues than `H` has on
 //! `ker A` (`m` the multipliers, `A` of full rank), and the count is the
 //! number of negative pivots of a symmetric indefinite (Bunch–Kaufman)
-//! factorisation `P J Pᵀ = L B Lᵀ`. It changes where, and only where, an
-//! eigenvalue crosses zero: a critical point, whichever mode is the least in
-//! magnitude on either side.
+//! factorisation `P J Pᵀ = L B Lᵀ` — dense up to [`INERTIA_ROWS`] rows, of
+//! the congruent augmented tangent by a sparse supernodal one above
+//! ([`InertiaStructure`]), so that every symmetric tangent has its count.
+//! It changes where, and only where, an eigenvalue crosses zero: a critical
+//! point, whichever mode is the least in magnitude on either side.
 
-use faer::Mat;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::{Mat, Side};
 use serde::Serialize;
 
 use super::assembly::{State, System};
 use super::model::MechanicsError;
 use super::solver::{wdot, StaticSolver};
+use crate::algebra::Plain;
 
 /// Inverse iterations at most.
 const MAX_ITERATIONS: usize = 60;
@@ -180,9 +191,10 @@ fn inverse_iteration(
     unreachable!("the last iteration returns")
 }
 
-/// Rows up to which the tangent's inertia is counted ([`negative_eigenvalues`]):
-/// a dense Bunch–Kaufman factorisation, `n³/3` operations (≈ 0.3 G at
-/// 1 000 rows, tens of ms), beside the sparse LU of the solves.
+/// Rows up to which the tangent's inertia is counted dense
+/// ([`dense_negative_eigenvalues`]): a Bunch–Kaufman factorisation with
+/// pivoting over the whole matrix, `n³/3` operations (≈ 0.3 G at 1 000 rows,
+/// tens of ms). Above, the sparse count ([`InertiaStructure`]).
 pub(super) const INERTIA_ROWS: usize = 1_000;
 
 /// An equilibrium's tangent counts as symmetric when no entry differs from
@@ -193,21 +205,34 @@ pub(super) const INERTIA_ROWS: usize = 1_000;
 const SYMMETRY: f64 = 1e-8;
 
 /// The number of negative eigenvalues of the stiffness on the joints'
-/// constraints at `state` (module doc): the negative pivots of the
-/// Bunch–Kaufman `LBLᵀ` of the tangent, less one per multiplier. `None`
-/// for a tangent of more than [`INERTIA_ROWS`] rows, with entries that are
-/// not finite, or unsymmetric ([`SYMMETRY`]: loads that are not
+/// constraints at `state` (module doc): the negative pivots of a symmetric
+/// indefinite factorisation of the tangent, less one per multiplier —
+/// dense up to [`INERTIA_ROWS`] rows ([`dense_negative_eigenvalues`]),
+/// sparse above ([`InertiaStructure`]). `None` for a tangent with entries
+/// that are not finite, or unsymmetric ([`SYMMETRY`]: loads that are not
 /// conservative have no energy whose second variation the inertia would
-/// count).
+/// count), or whose sparse factorisation could not be analysed or met a
+/// pivot that is not finite.
 pub(super) fn negative_eigenvalues(
     solver: &StaticSolver,
     state: &State,
     lambda: f64,
 ) -> Option<usize> {
-    let system = solver.system();
-    if system.n_rows > INERTIA_ROWS {
-        return None;
+    if solver.system().n_rows <= INERTIA_ROWS {
+        dense_negative_eigenvalues(solver, state, lambda)
+    } else {
+        sparse_negative_eigenvalues(solver, state, lambda)
     }
+}
+
+/// [`negative_eigenvalues`] by faer's dense Bunch–Kaufman `LBLᵀ` of the
+/// whole tangent, whatever its size.
+pub(super) fn dense_negative_eigenvalues(
+    solver: &StaticSolver,
+    state: &State,
+    lambda: f64,
+) -> Option<usize> {
+    let system = solver.system();
     let ev = system.evaluate(solver.model(), state, lambda);
     if ev.values.iter().any(|v| !v.is_finite()) {
         return None;
@@ -229,26 +254,329 @@ pub(super) fn negative_eigenvalues(
     let lblt = symmetric.lblt(faer::Side::Lower);
     let (diag, sub) = (lblt.B_diag(), lblt.B_subdiag());
     let (diag, sub) = (diag.column_vector(), sub.column_vector());
-    let mut negative = 0;
-    let mut i = 0;
-    while i < n {
-        if i + 1 < n && sub[i] != 0.0 {
-            // A 2×2 block: its eigenvalues' signs from its determinant and
-            // trace.
-            let (a, b, c) = (diag[i], sub[i], diag[i + 1]);
-            let det = a * c - b * b;
-            negative += match (det < 0.0, a + c < 0.0) {
-                (true, _) => 1,
-                (false, true) => 2,
-                (false, false) => 0,
-            };
-            i += 2;
-        } else {
-            negative += usize::from(diag[i] < 0.0);
-            i += 1;
-        }
-    }
+    let negative = negative_pivots((0..n).map(|i| (diag[i], sub[i])))?;
     Some(negative.saturating_sub(n - system.n_free))
+}
+
+/// [`negative_eigenvalues`] by the sparse count ([`InertiaStructure`]),
+/// whatever the tangent's size.
+pub(super) fn sparse_negative_eigenvalues(
+    solver: &StaticSolver,
+    state: &State,
+    lambda: f64,
+) -> Option<usize> {
+    let system = solver.system();
+    let ev = system.evaluate(solver.model(), state, lambda);
+    if ev.values.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let j = system.sparse_tangent(&ev.values).ok()?;
+    let structure = system
+        .inertia
+        .get_or_init(|| InertiaStructure::new(&j, system.n_free, system.scale).ok())
+        .as_ref()?;
+    structure.negative_eigenvalues(&j)
+}
+
+/// The negative eigenvalues of a block-diagonal `B` of 1×1 and 2×2 blocks,
+/// given as each row's diagonal entry and the entry below it (nonzero: a
+/// 2×2 block starts there). `None` when an entry is not finite (a zero
+/// pivot met on the way).
+fn negative_pivots(mut rows: impl Iterator<Item = (f64, f64)>) -> Option<usize> {
+    let mut negative = 0;
+    while let Some((a, b)) = rows.next() {
+        if !(a.is_finite() && b.is_finite()) {
+            return None;
+        }
+        if b == 0.0 {
+            negative += usize::from(a < 0.0);
+            continue;
+        }
+        // A 2×2 block: its eigenvalues' signs from its determinant and
+        // trace.
+        let (c, _) = rows.next()?;
+        if !c.is_finite() {
+            return None;
+        }
+        let det = a * c - b * b;
+        negative += match (det < 0.0, a + c < 0.0) {
+            (true, _) => 1,
+            (false, true) => 2,
+            (false, false) => 0,
+        };
+    }
+    Some(negative)
+}
+
+/// Where an entry of `J_ρ`'s lower triangle ([`InertiaStructure`]) takes
+/// its value from: positions in the tangent's compressed columns.
+#[derive(Debug, Clone, Copy)]
+enum Source {
+    /// The tangent's symmetric part at this position.
+    Tangent(usize),
+    /// `ρ aᵢ aⱼ`, the constraint row's entries at these two positions.
+    Penalty(usize, usize),
+}
+
+/// The sparse inertia count of a model's tangents: the structure, analysed
+/// once per model.
+///
+/// Without pivoting, an `LDLᵀ` of the saddle-point tangent
+/// `J = [[H, Aᵀ], [A, 0]]` breaks on the zero block wherever a multiplier
+/// comes before its joint's unknowns, and on `H` itself where a body or a
+/// rod is held only by its joints (`H` is singular there: the rigid motions
+/// the joints alone stop). The matrix factored is instead
+///
+/// ```text
+/// J_ρ = ⎡ H + ρ AᵀA   Aᵀ ⎤  = Tᵀ J T,   T = ⎡ I      0 ⎤
+///       ⎣ A           0  ⎦                  ⎣ ρA/2   I ⎦
+/// ```
+///
+/// congruent to `J`, so of exactly its inertia (Sylvester) for any `ρ`
+/// (the augmented Lagrangian: `H + ρAᵀA` is `H` on `ker A`). With
+/// `ρ = 1/s` (`s` the constraint scale, [`super::assembly`]) the penalty
+/// `s GᵀG` is as stiff as the stiffest element: enough, in practice, for
+/// `H + ρAᵀA` to be positive definite wherever the frame is stable (it is
+/// for `ρ` large enough, Finsler; a rod or body that only joints hold has
+/// its rigid motions stiffened by it). The joint nodes' blocks it fills
+/// are in the tangent's pattern already. The order eliminates `H`'s
+/// unknowns by approximate minimum degree, each multiplier right after the
+/// last of its joint's unknowns: every leading block is then the saddle
+/// point of a part of the frame with the later unknowns clamped, which is
+/// nonsingular when `H + ρAᵀA` is definite (its principal blocks are, and
+/// `A`'s rows stay independent), so that no pivot is zero on a stable
+/// state. Past a critical point the count stays exact while no pivot is;
+/// faer's supernodal `LBLᵀ` pivots by Bunch–Kaufman inside each supernode,
+/// against small pivots there. A pivot that is not finite (a zero one
+/// met) leaves the count out (`None`), not wrong.
+///
+/// Measured against the dense count ([`dense_negative_eigenvalues`], the
+/// tests below): the same count at every point of load sweeps through the
+/// column's two Euler loads, the Argyris frame's two bifurcations and the
+/// ring truss's double one (bodies held by revolute and fixed joints only).
+/// At 1 038 rows (the ring truss) it takes 4 ms where the dense count takes
+/// 30–55 ms and the inverse iteration of [`lowest_eigenpair`] 5 ms: one
+/// symbolic analysis per model, one numeric factorisation per count.
+///
+/// Rejected: a penalty form `H + ρAᵀA` alone (no multipliers) counts
+/// `H`'s negative eigenvalues on `ker A` only for `ρ` large against
+/// `‖H‖²/μ` (`μ` the eigenvalue crossing zero, ~1e-8 of `‖H‖` for slender
+/// rods), where roundoff in `ρAᵀA` swamps `H`; and a shift `−δI` on the
+/// zero block, whose count is `J`'s only for `δ` below the least
+/// eigenvalue, unknown near a crossing, and whose pivots grow as `1/δ`.
+pub(crate) struct InertiaStructure {
+    /// Position of each tangent entry's transpose.
+    mirror: Vec<usize>,
+    /// Free unknowns: the multipliers follow.
+    n_free: usize,
+    /// `ρ = 1/s`, m/N.
+    rho: f64,
+    /// `J_ρ`'s lower triangle: its pattern and each entry's source.
+    symbolic: SymbolicSparseColMat<usize>,
+    argsort: Argsort<usize>,
+    source: Vec<Source>,
+    /// Its symbolic supernodal factorisation in the order above.
+    cholesky: SymbolicCholesky<usize>,
+}
+
+impl InertiaStructure {
+    /// The structure for tangents of `j`'s pattern (structurally symmetric,
+    /// every diagonal entry present), `n_free` free unknowns, constraint
+    /// scale `scale` (N/m).
+    ///
+    /// # Errors
+    /// A pattern that is not symmetric or that faer cannot analyse
+    /// (named).
+    fn new(j: &SparseColMat<usize, f64>, n_free: usize, scale: f64) -> Result<Self, String> {
+        let n = j.nrows();
+        let (col_ptr, row_idx) = (j.symbolic().col_ptr(), j.symbolic().row_idx());
+        let mut mirror = vec![0; row_idx.len()];
+        let mut entries = Vec::new();
+        for c in 0..n {
+            for p in col_ptr[c]..col_ptr[c + 1] {
+                let r = row_idx[p];
+                let column = &row_idx[col_ptr[r]..col_ptr[r + 1]];
+                let q = column.binary_search(&c).map_err(|_| {
+                    format!("the tangent's pattern has ({r}, {c}) but not ({c}, {r})")
+                })?;
+                mirror[p] = col_ptr[r] + q;
+                if r >= c {
+                    entries.push((Pair { row: r, col: c }, Source::Tangent(p)));
+                }
+            }
+        }
+        // ρ AᵀA: A's row r is the multiplier column r above the diagonal.
+        for r in n_free..n {
+            let a: Vec<usize> = (col_ptr[r]..col_ptr[r + 1])
+                .filter(|&p| row_idx[p] < n_free)
+                .collect();
+            for &p in &a {
+                for &q in &a {
+                    if row_idx[p] >= row_idx[q] {
+                        let at = Pair {
+                            row: row_idx[p],
+                            col: row_idx[q],
+                        };
+                        entries.push((at, Source::Penalty(p, q)));
+                    }
+                }
+            }
+        }
+        let (pairs, source): (Vec<_>, Vec<_>) = entries.into_iter().unzip();
+        let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &pairs)
+            .map_err(|e| format!("pattern of the inertia count: {}", e.plain()))?;
+        let order = Self::ordering(&symbolic, n_free)?;
+        let cholesky = factorize_symbolic_cholesky(
+            symbolic.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Custom(order.as_ref()),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| format!("symbolic LBLᵀ of the tangent: {}", e.plain()))?;
+        Ok(InertiaStructure {
+            mirror,
+            n_free,
+            rho: 1.0 / scale,
+            symbolic,
+            argsort,
+            source,
+            cholesky,
+        })
+    }
+
+    /// The elimination order of `J_ρ` (lower pattern `symbolic`):
+    /// the first `n_free` unknowns by approximate minimum degree, each
+    /// multiplier right after the last of its unknowns (a multiplier
+    /// coupled to none, last).
+    fn ordering(
+        symbolic: &SymbolicSparseColMat<usize>,
+        n_free: usize,
+    ) -> Result<faer::perm::Perm<usize>, String> {
+        let n = symbolic.nrows();
+        let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+        let mut h_ptr = vec![0usize; n_free + 1];
+        let mut h_idx = Vec::new();
+        for c in 0..n_free {
+            h_idx.extend(
+                row_idx[col_ptr[c]..col_ptr[c + 1]]
+                    .iter()
+                    .filter(|&&r| r < n_free),
+            );
+            h_ptr[c + 1] = h_idx.len();
+        }
+        let h = SymbolicSparseColMat::new_checked(n_free, n_free, h_ptr, None, h_idx);
+        let (mut fwd_h, mut inv_h) = (vec![0usize; n_free], vec![0usize; n_free]);
+        let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n_free, h.compute_nnz()))
+            .map_err(|_| "out of memory for the AMD ordering of the tangent".to_string())?;
+        amd::order(
+            &mut fwd_h,
+            &mut inv_h,
+            h.as_ref(),
+            amd::Control::default(),
+            MemStack::new(&mut mem),
+        )
+        .map_err(|e| format!("AMD ordering of the tangent: {}", e.plain()))?;
+        // The position after which each multiplier is eliminated.
+        let mut last: Vec<Option<usize>> = vec![None; n - n_free];
+        for c in 0..n_free {
+            for &r in row_idx[col_ptr[c]..col_ptr[c + 1]]
+                .iter()
+                .filter(|&&r| r >= n_free)
+            {
+                let slot = &mut last[r - n_free];
+                *slot = Some(slot.map_or(inv_h[c], |k: usize| k.max(inv_h[c])));
+            }
+        }
+        let mut after = vec![Vec::new(); n_free];
+        let mut loose = Vec::new();
+        for (k, at) in last.iter().enumerate() {
+            match at {
+                Some(at) => after[*at].push(n_free + k),
+                None => loose.push(n_free + k),
+            }
+        }
+        let mut fwd = Vec::with_capacity(n);
+        for (k, rows) in after.iter().enumerate() {
+            fwd.push(fwd_h[k]);
+            fwd.extend(rows);
+        }
+        fwd.extend(loose);
+        let mut inv = vec![0usize; n];
+        for (k, &i) in fwd.iter().enumerate() {
+            inv[i] = k;
+        }
+        Ok(faer::perm::Perm::new_checked(
+            fwd.into_boxed_slice(),
+            inv.into_boxed_slice(),
+            n,
+        ))
+    }
+
+    /// The negative eigenvalues on the constraints of the tangent `j`
+    /// (of the pattern analysed): the negative pivots of `J_ρ`'s
+    /// supernodal `LBLᵀ`, less one per multiplier. `None` for `j`
+    /// unsymmetric ([`SYMMETRY`]), out of memory or with a pivot that is
+    /// not finite.
+    fn negative_eigenvalues(&self, j: &SparseColMat<usize, f64>) -> Option<usize> {
+        let v = j.as_ref().val();
+        let largest = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let asymmetry = v
+            .iter()
+            .zip(&self.mirror)
+            .fold(0.0_f64, |m, (x, &q)| m.max((x - v[q]).abs()));
+        if asymmetry > SYMMETRY * largest {
+            return None;
+        }
+        let symmetric = |p: usize| 0.5 * (v[p] + v[self.mirror[p]]);
+        let gathered: Vec<f64> = self
+            .source
+            .iter()
+            .map(|s| match *s {
+                Source::Tangent(p) => symmetric(p),
+                Source::Penalty(p, q) => self.rho * symmetric(p) * symmetric(q),
+            })
+            .collect();
+        let k =
+            SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, &gathered).ok()?;
+        let n = k.nrows();
+        let par = faer::get_global_parallelism();
+        let mut l = vec![0.0; self.cholesky.len_val()];
+        let mut subdiag = vec![0.0; n];
+        let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+        let mut buffer = MemBuffer::try_new(
+            self.cholesky
+                .factorize_numeric_intranode_lblt_scratch::<f64>(par, Default::default()),
+        )
+        .ok()?;
+        self.cholesky.factorize_numeric_intranode_lblt(
+            &mut l,
+            &mut subdiag,
+            &mut fwd,
+            &mut inv,
+            k.as_ref(),
+            Side::Lower,
+            par,
+            MemStack::new(&mut buffer),
+            Default::default(),
+        );
+        let SymbolicCholeskyRaw::Supernodal(supernodal) = self.cholesky.raw() else {
+            unreachable!("the inertia's factor is supernodal by its parameters")
+        };
+        // Each supernode's values: its columns, column-major, diagonal
+        // block on top (B's diagonal on its diagonal).
+        let (begin, end) = (supernodal.supernode_begin(), supernodal.supernode_end());
+        let at = supernodal.col_ptr_for_val();
+        let pivots = (0..supernodal.n_supernodes()).flat_map(|s| {
+            let columns = end[s] - begin[s];
+            let rows = (at[s + 1] - at[s]) / columns;
+            (0..columns).map(move |c| (at[s] + c * rows + c, begin[s] + c))
+        });
+        let negative = negative_pivots(pivots.map(|(d, i)| (l[d], subdiag[i])))?;
+        Some(negative.saturating_sub(n - self.n_free))
+    }
 }
 
 /// Every node's translation in the unknowns `z` (0 where fixed), scaled so
@@ -338,6 +666,156 @@ mod tests {
             let independent = negative_by_eigenvalues(&solver, &solution.state, 1.0);
             assert_eq!(independent, expected, "P = {p} N");
             assert_eq!(counted, Some(expected), "P = {p} N");
+            let sparse = sparse_negative_eigenvalues(&solver, &solution.state, 1.0);
+            assert_eq!(sparse, Some(expected), "P = {p} N");
         }
+    }
+
+    /// The dense and sparse counts at equilibria of `file` under its loads
+    /// times each of `factors` (increasing), each solved by load control
+    /// from the last: the fundamental path, through and past its
+    /// bifurcations. Returns the counts.
+    fn counts_along(file: &crate::frame::FrameFile, factors: &[f64]) -> Vec<usize> {
+        let mut solver = StaticSolver::new(file.model.clone()).unwrap();
+        let base = file.model.loads().to_vec();
+        let settings = StaticSettings {
+            max_step: 0.25,
+            ..StaticSettings::default()
+        };
+        let (mut state, mut last) = (solver.reference_state(), 0.0);
+        let mut counts = Vec::new();
+        for &t in factors {
+            let scaled = base
+                .iter()
+                .map(|l| crate::mechanics::NodalLoad {
+                    force_n: l.force_n * t,
+                    moment_nm: l.moment_nm * t,
+                    ..*l
+                })
+                .collect();
+            solver.model_mut().set_loads(scaled).unwrap();
+            let solution = solver.solve_from(state, last / t, &settings).unwrap();
+            assert_eq!(solution.termination, StaticTermination::Converged, "× {t}");
+            let dense = dense_negative_eigenvalues(&solver, &solution.state, 1.0);
+            let sparse = sparse_negative_eigenvalues(&solver, &solution.state, 1.0);
+            assert!(dense.is_some(), "× {t}");
+            assert_eq!(sparse, dense, "× {t}");
+            counts.push(dense.unwrap());
+            (state, last) = (solution.state, t);
+        }
+        counts
+    }
+
+    /// The Argyris frame (`tests/critical_points.rs`): 2 × 10 elements, a
+    /// fixed joint at the corner, so the second leg is held by the joint
+    /// alone; bending stiffnesses `[in-plane, out-of-plane]`, tip force
+    /// 1 N across the second leg.
+    fn argyris(bending: [f64; 2]) -> crate::frame::FrameFile {
+        let text = format!(
+            r#"
+nodes = [
+  {{ name = "root", position_m = [0.0, 0.0, 0.0] }},
+  {{ name = "corner", position_m = [240.0, 0.0, 0.0] }},
+  {{ name = "tip", position_m = [240.0, 240.0, 0.0] }},
+]
+[sections.s]
+axial_n = 1.28232e6
+shear_n = [4.8942e5, 4.8942e5]
+torsion_nm2 = 58730.4
+bending_nm2 = {bending:?}
+[[rods]]
+name = "leg1"
+start = "root"
+end = "corner"
+section = "s"
+elements = 10
+up = [0.0, 0.0, 1.0]
+[[rods]]
+name = "leg2"
+start = "corner"
+end = "tip"
+section = "s"
+elements = 10
+up = [0.0, 0.0, 1.0]
+[[joints]]
+kind = "fixed"
+a = {{ rod = "leg1", end = "end" }}
+b = {{ rod = "leg2", end = "start" }}
+[[supports]]
+on = {{ rod = "leg1", end = "start" }}
+fixed = ["all"]
+[[loads]]
+on = {{ rod = "leg2", end = "end" }}
+force_n = [-1.0, 0.0, 0.0]
+"#
+        );
+        crate::frame::FrameFile::from_toml(&text).unwrap()
+    }
+
+    #[test]
+    fn the_sparse_count_is_the_dense_one_through_the_argyris_frames_buckling() {
+        // Deep section: lateral buckling between 0.6 and 0.7 N, a second
+        // mode between 2.4 and 2.5 N on the (unstable) fundamental path.
+        let file = argyris([9.6174e7, 38470.0]);
+        let factors: Vec<f64> = (1..=30).map(|k| 0.1 * k as f64).collect();
+        let counts = counts_along(&file, &factors);
+        assert_eq!((counts[0], counts[9], counts[29]), (0, 1, 2), "{counts:?}");
+    }
+
+    #[test]
+    fn the_sparse_count_is_the_dense_one_through_the_ring_trusss_buckling() {
+        // 1 038 rows (above INERTIA_ROWS: the sparse count is the one
+        // paths use here). Hinge bodies held by revolute and fixed joints only; the file's
+        // radial loads turned down (−z), so that battens and diagonals
+        // carry the compression.
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("problems/frames/ring-truss-frame.toml");
+        let mut file = crate::frame::FrameFile::read(&path).unwrap();
+        let down = file
+            .model
+            .loads()
+            .iter()
+            .map(|l| crate::mechanics::NodalLoad {
+                force_n: nalgebra::Vector3::new(0.0, 0.0, -l.force_n.norm()),
+                ..*l
+            })
+            .collect();
+        file.model.set_loads(down).unwrap();
+        // A pair of modes crosses between 5.39 and 5.41 × the loads: the
+        // count jumps from 0 to 2 there (load control stops near 5.68).
+        let factors: Vec<f64> = (1..=10)
+            .map(|k| 0.5 * k as f64)
+            .chain((1..=20).map(|k| 5.0 + 0.034 * k as f64))
+            .collect();
+        let counts = counts_along(&file, &factors);
+        assert_eq!(counts[0], 0, "{counts:?}");
+        assert_eq!(*counts.last().unwrap(), 2, "{counts:?}");
+        assert!(counts.windows(2).all(|w| w[0] <= w[1]), "{counts:?}");
+    }
+
+    #[test]
+    fn a_moment_fixed_in_space_leaves_the_inertia_uncounted_dense_or_sparse() {
+        // Not conservative under finite rotations: the tangent is
+        // unsymmetric by the moment's size, and no energy's second
+        // variation is there to count.
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("problems/frames/cantilever-moment.toml");
+        let file = crate::frame::FrameFile::read(&path).unwrap();
+        let solver = StaticSolver::new(file.model.clone()).unwrap();
+        let solution = solver.solve(&file.settings).unwrap();
+        assert_eq!(solution.termination, StaticTermination::Converged);
+        let state = &solution.state;
+        assert_eq!(dense_negative_eigenvalues(&solver, state, 1.0), None);
+        assert_eq!(sparse_negative_eigenvalues(&solver, state, 1.0), None);
+        // The unloaded reference is symmetric: counted, both ways.
+        let reference = solver.reference_state();
+        assert_eq!(
+            dense_negative_eigenvalues(&solver, &reference, 0.0),
+            Some(0)
+        );
+        assert_eq!(
+            sparse_negative_eigenvalues(&solver, &reference, 0.0),
+            Some(0)
+        );
     }
 }
