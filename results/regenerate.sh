@@ -22,3 +22,10 @@ done
 "$ringmesh" size problems/paper-26m.toml --margin 2 --sections problems/carbon-tubes.csv -o results/paper-26m
 "$ringmesh" apertures problems/paper-26m.toml --apertures 26,40,60,80,100 -o results/paper-26m/apertures
 "$ringmesh" apertures problems/realistic-26m.toml --apertures 26,40,60,80,100 -o results/realistic-26m/apertures
+# The error budget of the three reference dishes (their [effects.thermal] and
+# [tolerances]): the flexible-truss design and the conventional one, each built
+# on the same flexible truss (results/<scene>/budget/, budget-conventional/).
+for scene in realistic-26m paper-26m super-60m; do
+    "$ringmesh" budget "problems/$scene.toml" -o "results/$scene/budget"
+    "$ringmesh" budget "problems/$scene.toml" --conventional -o "results/$scene/budget-conventional"
+done

@@ -357,12 +357,19 @@ pub enum Command {
         /// Seed of the samples [default: the scene's `[tolerances] seed`, else 1].
         #[arg(long)]
         seed: Option<u64>,
+        /// The budget of the conventional design (made for the undeformed
+        /// truss, the outer loop's iteration 0) built on the same flexible
+        /// truss, instead of the flexible-truss design's: which error the
+        /// flexible design removes, and what is left.
+        #[arg(long)]
+        conventional: bool,
         /// Run only shard I of N (from 0: point k runs when k mod N = I) and
         /// write budget-samples.shard-I-of-N.csv; join the shards with
         /// `ringmesh merge`.
         #[arg(long, value_name = "I/N")]
         shard: Option<Shard>,
-        /// Output folder [default: runs/<scene name>].
+        /// Output folder [default: runs/<scene name>, with --conventional
+        /// runs/<scene name>/conventional].
         #[arg(short, long)]
         output: Option<PathBuf>,
     },

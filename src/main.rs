@@ -11,6 +11,7 @@ mod progress;
 use std::process::ExitCode;
 
 use clap::Parser;
+use ringmesh::budget::BudgetDesign;
 use ringmesh::run::{self, Summary};
 
 use cli::{Cli, Command};
@@ -172,11 +173,23 @@ fn dispatch(command: &Command) -> Result<Summary, ringmesh::Error> {
             scene,
             samples,
             seed,
+            conventional,
             shard,
             output,
         } => {
             let progress = bar();
-            let result = run::budget(scene, *samples, *seed, output.as_deref(), *shard, &progress);
+            let design = match conventional {
+                true => BudgetDesign::Conventional,
+                false => BudgetDesign::Flexible,
+            };
+            let result = run::budget(
+                scene,
+                (*samples, *seed),
+                design,
+                output.as_deref(),
+                *shard,
+                &progress,
+            );
             progress.0.finish_and_clear();
             result?.summary()
         }

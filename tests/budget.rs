@@ -4,12 +4,13 @@
 mod common;
 
 use ringmesh::budget::{
-    thermal_perturbation, BudgetRow, BudgetTable, Measured, PerturbedAssembly, PointKind,
-    ToleranceModel,
+    self, thermal_perturbation, BudgetDesign, BudgetRow, BudgetSettings, BudgetTable, Measured,
+    PerturbedAssembly, PointKind, ToleranceModel,
 };
 use ringmesh::design::{self, DesignRun, DesignSettings};
 use ringmesh::effects::ThermalExpansion;
 use ringmesh::scene::{Thermal, ThermalCase, Tolerances};
+use ringmesh::shard::Shard;
 use ringmesh::verify::{Perturbation, Verification};
 use ringmesh::Scene;
 
@@ -375,6 +376,67 @@ fn chord_iterations_on_the_designs_tangent_find_newtons_equilibrium() {
     assert!(
         chords >= 4,
         "the chord iterations converged on {chords} of 6 samples"
+    );
+}
+
+#[test]
+fn the_conventional_designs_budget_starts_from_its_assembly_on_the_flexible_truss() {
+    // `budget --conventional` builds the loop's iteration 0 — the design
+    // for the undeformed truss — on the same flexible truss: its design
+    // term is the conventional verification the design run reports, far
+    // above the flexible design's, and its tolerance samples perturb that
+    // assembly.
+    let mut scene = common::scene("small-hex");
+    let mut t = tolerances(1e-7, 0.0);
+    t.samples = Some(3);
+    scene.tolerances = Some(t);
+    let design_term = |design: BudgetDesign| {
+        let settings = BudgetSettings {
+            design,
+            ..BudgetSettings::of(&scene, None, None)
+        };
+        let run = budget::run(
+            &scene,
+            &DesignSettings::default(),
+            &settings,
+            Shard::WHOLE,
+            &|_| {},
+        )
+        .expect("a budget");
+        let row = |kind: PointKind| {
+            run.rows
+                .iter()
+                .find(|(_, r)| r.kind == kind)
+                .map(|(_, r)| r.nonlinear.clone().expect("measured"))
+                .expect("a row")
+        };
+        let samples = run
+            .rows
+            .iter()
+            .filter(|(_, r)| r.kind == PointKind::Sample && r.nonlinear.is_ok())
+            .count();
+        assert_eq!(samples, 3, "{design:?}: every sample assembles");
+        row(PointKind::Design)
+    };
+    let (_, reference) = designed();
+    let conventional = reference
+        .report
+        .conventional
+        .as_ref()
+        .expect("a flexible truss has a conventional design");
+    let c = design_term(BudgetDesign::Conventional);
+    assert!(
+        (c.raw_mm - conventional.rms_mm).abs() <= 1e-9 * conventional.rms_mm,
+        "conventional design term {} mm against its verification's {} mm",
+        c.raw_mm,
+        conventional.rms_mm
+    );
+    let f = design_term(BudgetDesign::Flexible);
+    assert!(
+        f.raw_mm < 1e-3 * c.raw_mm,
+        "the flexible design ({} mm) does not remove the conventional one's error ({} mm)",
+        f.raw_mm,
+        c.raw_mm
     );
 }
 

@@ -98,14 +98,40 @@ impl BudgetError {
     }
 }
 
+/// Which design a budget builds and perturbs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BudgetDesign {
+    /// The design for the flexible truss (the outer loop's converged one).
+    #[default]
+    Flexible,
+    /// The conventional design — the loop's iteration 0, made for the
+    /// undeformed truss (DESIGN §7) — built on the same flexible truss: its
+    /// budget against the flexible design's shows which error the
+    /// flexible-truss design removes and what is left.
+    Conventional,
+}
+
+impl BudgetDesign {
+    /// Its name in files and printouts.
+    pub fn name(self) -> &'static str {
+        match self {
+            BudgetDesign::Flexible => "flexible",
+            BudgetDesign::Conventional => "conventional",
+        }
+    }
+}
+
 /// What a budget draws: samples and seed (the scene's `[tolerances]` or the
-/// command line's).
+/// command line's), and the design it builds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct BudgetSettings {
     /// Monte Carlo samples (0 without tolerances).
     pub samples: usize,
     /// Their seed.
     pub seed: u64,
+    /// The design built.
+    pub design: BudgetDesign,
 }
 
 impl BudgetSettings {
@@ -118,6 +144,7 @@ impl BudgetSettings {
                 Some(t) => samples.or(t.samples).unwrap_or(DEFAULT_SAMPLES),
             },
             seed: seed.or(t.and_then(|t| t.seed)).unwrap_or(DEFAULT_SEED),
+            design: BudgetDesign::Flexible,
         }
     }
 }
@@ -185,14 +212,26 @@ pub fn run(
     let run = design::run(scene, design, &mut |_, _| {})?;
     timings.design_s = clock.elapsed().as_secs_f64();
     let scene = &resolve(scene)?;
+    let (network, net, start) = match settings.design {
+        BudgetDesign::Flexible => (
+            &run.network,
+            &run.report.net,
+            run.truss_equilibrium.as_ref(),
+        ),
+        BudgetDesign::Conventional => match (&run.conventional_start, &run.conventional_net) {
+            (Some((network, start)), Some(net)) => (network, net, start.as_ref()),
+            _ => {
+                return Err(BudgetError::Scene {
+                    key: "effects.truss",
+                    reason: "rigid: the design is made for the undeformed truss already, \
+                             there is no conventional design to compare"
+                        .into(),
+                })
+            }
+        },
+    };
     let clock = Instant::now();
-    let core = PerturbedAssembly::new(
-        scene,
-        &run.mesh,
-        &run.network,
-        &run.report.net,
-        run.truss_equilibrium.as_ref(),
-    )?;
+    let core = PerturbedAssembly::new(scene, &run.mesh, network, net, start)?;
     timings.assembly_s = clock.elapsed().as_secs_f64();
     let clock = Instant::now();
     let tangent = core.linearise()?;
@@ -203,7 +242,7 @@ pub fn run(
     let tolerances = scene
         .tolerances
         .as_ref()
-        .map(|t| ToleranceModel::new(t, &run.mesh, &run.network, &run.report.net, &scene.cables));
+        .map(|t| ToleranceModel::new(t, &run.mesh, network, net, &scene.cables));
     let points = point_count(scene, settings);
     let mine = shard.points(points);
     let first_sample = 2 + cases.len();
@@ -241,13 +280,7 @@ pub fn run(
             let (kind, name, p) = if k < first_sample {
                 let case = &cases[k - 2];
                 let effect = thermal.as_ref().expect("cases come from the effect");
-                let p = thermal_perturbation(
-                    effect,
-                    case,
-                    mesh,
-                    &run.network,
-                    &run.report.net.nodes_xyz_m,
-                );
+                let p = thermal_perturbation(effect, case, mesh, network, &net.nodes_xyz_m);
                 (PointKind::Thermal, case.name.clone(), p)
             } else {
                 let s = k - first_sample;

@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 
 use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
 use crate::budget::{
-    self, BudgetRow, BudgetSettings, BudgetTable, BudgetTimings, PointKind, POINT_COLUMNS,
+    self, BudgetDesign, BudgetRow, BudgetSettings, BudgetTable, BudgetTimings, PointKind,
+    POINT_COLUMNS,
 };
 use crate::design::DesignSettings;
 use crate::report::{budget_plot, readable, write_atomic, write_json, OutputSet};
@@ -123,21 +124,31 @@ fn table_lines(s: &mut Summary, table: &BudgetTable) {
     }
 }
 
-/// `ringmesh budget`: the budget of the scene at `scene_path` with
-/// `samples` and `seed` (the scene's `[tolerances]` when not given),
-/// written into `output_dir` (default `runs/<scene>/`); with `shard`,
-/// only that shard's points as `budget-samples.shard-I-of-N.csv`.
+/// `ringmesh budget`: the budget of `design` of the scene at `scene_path`
+/// with `samples` and `seed` (the scene's `[tolerances]` when not given),
+/// written into `output_dir` (default `runs/<scene>/`, the conventional
+/// design's `runs/<scene>/conventional/`); with `shard`, only that shard's
+/// points as `budget-samples.shard-I-of-N.csv`.
 pub fn budget(
     scene_path: &Path,
-    samples: Option<usize>,
-    seed: Option<u64>,
+    (samples, seed): (Option<usize>, Option<u64>),
+    design: BudgetDesign,
     output_dir: Option<&Path>,
     shard: Option<Shard>,
     progress: &dyn Progress,
 ) -> Result<BudgetOutcome, Error> {
     let scene = read_scene(scene_path)?;
-    let dir = output_dir.map_or_else(|| default_output_dir(&scene), Path::to_path_buf);
-    let settings = BudgetSettings::of(&scene, samples, seed);
+    let dir = output_dir.map_or_else(
+        || match design {
+            BudgetDesign::Flexible => default_output_dir(&scene),
+            BudgetDesign::Conventional => default_output_dir(&scene).join("conventional"),
+        },
+        Path::to_path_buf,
+    );
+    let settings = BudgetSettings {
+        design,
+        ..BudgetSettings::of(&scene, samples, seed)
+    };
     let set = match shard {
         Some(_) => None,
         None => Some(OutputSet::begin(&dir, &FILES)?),
@@ -160,6 +171,7 @@ pub fn budget(
     let settings_json = serde_json::json!({
         "samples": settings.samples,
         "seed": settings.seed,
+        "design": settings.design.name(),
     });
     let lines: Vec<(usize, String)> = run.rows.iter().map(|(k, r)| (*k, r.csv())).collect();
     let rows: Vec<BudgetRow> = run.rows.into_iter().map(|(_, r)| r).collect();
@@ -234,10 +246,11 @@ pub(crate) fn write_budget(
             Some((n, l))
         })
         .collect();
+    let design = settings["design"].as_str().unwrap_or("flexible");
     budget_plot(
         &table,
         &samples,
-        &format!("{scene}: error budget as built on the flexible truss"),
+        &format!("{scene}: error budget of the {design} design as built on the flexible truss"),
         &set.path("budget.png"),
         &set.path("budget.svg"),
     )?;
