@@ -25,6 +25,9 @@ pub(crate) const FILES: [&str; 5] = [
     "budget.svg",
 ];
 
+/// Slack cables a printout names per thermal case (the files name all).
+const PRINTED_SLACK: usize = 20;
+
 /// The stem of the points' table and its shards.
 pub(crate) const STEM: &str = "budget-samples";
 
@@ -95,10 +98,18 @@ fn table_lines(s: &mut Summary, table: &BudgetTable) {
     }
     for (case, slack) in &table.thermal_slack_cables {
         if !slack.is_empty() {
-            let list: Vec<String> = slack.iter().map(|k| k.to_string()).collect();
+            let list: Vec<String> = slack
+                .iter()
+                .take(PRINTED_SLACK)
+                .map(|k| k.to_string())
+                .collect();
+            let more = match slack.len() > PRINTED_SLACK {
+                true => " … (all in budget.json and budget-samples.csv)",
+                false => "",
+            };
             say!(
                 s,
-                "thermal case {case}: {} cables slack: {}",
+                "thermal case {case}: {} cables slack: {}{more}",
                 slack.len(),
                 list.join(" ")
             );

@@ -395,6 +395,13 @@ fn assembly_settings() -> StaticSettings {
     }
 }
 
+/// Load steps a perturbed assembly's ramp from the design's cut lengths is
+/// given: one whose net goes slack piece by piece can otherwise take
+/// hundreds of cut steps, each a factorisation (a super-60m thermal case
+/// ran for more than 5 minutes); past them the point fails, saying so,
+/// and a budget reports it.
+const PERTURBED_MAX_STEPS: usize = 40;
+
 /// Chord iterations a perturbed assembly is given from its design's
 /// tangent ([`Linearised::solve`]) before Newton takes over.
 const CHORD_ITERATIONS: usize = 20;
@@ -488,7 +495,11 @@ pub fn assemble(
             // ramped from the design's, in load steps.
             let solver = StaticSolver::new(models.ramped_from_design().build()?)?;
             let start = start_of(&solver, guess);
-            let s = solver.solve_from(start, 0.0, &settings)?;
+            let ramp = StaticSettings {
+                max_steps: PERTURBED_MAX_STEPS,
+                ..settings.clone()
+            };
+            let s = solver.solve_from(start, 0.0, &ramp)?;
             // At load factor 1 its model is the perturbed assembly's. If it
             // fails, so does the assembly: the ramp from the undeformed
             // truss would repeat the design's whole assembly to find what
