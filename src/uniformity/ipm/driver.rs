@@ -201,7 +201,8 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
             let Ok(c) = system.direction(&point, &r, Rhs::Centrality) else {
                 break;
             };
-            let trial = d.plus(&c);
+            let mut trial = d.clone();
+            trial.add_scaled(1.0, &c);
             let (np, nd) = steps(&point, &trial);
             if np.min(nd) < 1.01 * bp.min(bd) {
                 break;

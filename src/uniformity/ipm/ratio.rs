@@ -4,7 +4,7 @@
 //! and the final projection of the driver's best iterate onto equilibrium.
 
 use super::data::{Program, RatioLp};
-use super::direction::{Direction, Rhs as LpRhs, Scaling};
+use super::direction::{Rhs as LpRhs, Scaling};
 use super::driver;
 use super::error::{IpmError, NormalError};
 use super::normal::NormalMatrix;
@@ -300,14 +300,7 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
         } else {
             (&self.rp[..], &self.rw[..], &self.rd[..], self.rs)
         };
-        let Direction {
-            mut dx,
-            mut dz,
-            dw,
-            dlam,
-            dy,
-            ds,
-        } = program.direction(
+        Ok(program.direction(
             &mut self.normal,
             sc,
             x,
@@ -322,14 +315,6 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
                 rxz,
                 rwl,
             },
-        );
-        dx.extend(dw);
-        dz.extend(dlam);
-        Ok(Point {
-            primal: dx,
-            dual: dz,
-            free_primal: vec![ds],
-            free_dual: dy,
-        })
+        ))
     }
 }

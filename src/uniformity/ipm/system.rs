@@ -28,15 +28,13 @@ impl Point {
             .all(|v| v.iter().all(|x| x.is_finite()))
     }
 
-    /// `self + other`, entry by entry.
-    pub(crate) fn plus(&self, other: &Point) -> Point {
-        let add = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a + b).collect();
-        Point {
-            primal: add(&self.primal, &other.primal),
-            dual: add(&self.dual, &other.dual),
-            free_primal: add(&self.free_primal, &other.free_primal),
-            free_dual: add(&self.free_dual, &other.free_dual),
-        }
+    /// `self += alpha·other`, entry by entry.
+    pub(crate) fn add_scaled(&mut self, alpha: f64, other: &Point) {
+        let add = |a: &mut [f64], b: &[f64]| a.iter_mut().zip(b).for_each(|(a, b)| *a += alpha * b);
+        add(&mut self.primal, &other.primal);
+        add(&mut self.dual, &other.dual);
+        add(&mut self.free_primal, &other.free_primal);
+        add(&mut self.free_dual, &other.free_dual);
     }
 }
 

@@ -132,7 +132,10 @@ mod nets;
 /// The finish's interior-point iterations on the three net families of
 /// issue 38 at `RINGMESH_FINISH_FREE` free nodes (default 10 000), from
 /// `lp`'s optimum shifted by up to ±3 % per cable, with the finish's step
-/// rule and with the ratio LP's. Measurement, not a check: `cargo test
+/// rule (0.99 of the way to the boundary) and the ratio LP's adaptive
+/// fraction (the LP's separate primal and dual steps took 177 iterations
+/// where the common one took 95 on the hexagonal net, and are not tried).
+/// Measurement, not a check: `cargo test
 /// --release --lib finish_iteration_table -- --ignored --nocapture`.
 #[test]
 #[ignore = "measurement: prints a table"]
@@ -149,14 +152,6 @@ fn finish_iteration_table() {
             "common adaptive",
             IpmSettings {
                 step_length: StepLength::Adaptive,
-                ..finish_rule
-            },
-        ),
-        (
-            "separate adaptive",
-            IpmSettings {
-                step_length: StepLength::Adaptive,
-                separate_steps: true,
                 ..finish_rule
             },
         ),
@@ -178,12 +173,13 @@ fn finish_iteration_table() {
                 let done =
                     finish(&objective, &q, &FinishSettings::default(), program).expect("finish");
                 eprintln!(
-                    "{:>7} {:>6} free  {:<18} {:>2} programs {:>4} interior iterations  J {:.12e}  {:?}  {:.1} s {:?}",
+                    "{:>7} {:>6} free  {:<16} {:>2} programs {:>4} interior iterations ({:.1} each)  J {:.12e}  {:?}  {:.1} s {:?}",
                     family.name(),
                     problem.structure().free_nodes().len(),
                     name,
                     done.steps,
                     done.interior_iterations,
+                    done.interior_iterations as f64 / done.steps as f64,
                     done.objective,
                     done.termination,
                     start.elapsed().as_secs_f64(),
