@@ -151,11 +151,29 @@ struct LpSystem<'a, const D: usize> {
     scaling: Option<Scaling>,
 }
 
-/// The LP's parts of a point: `(x, w, z, λ, s, y)`.
-fn parts(point: &Point, m: usize) -> (&[f64], &[f64], &[f64], &[f64], f64, &[f64]) {
-    let (x, w) = point.primal.split_at(m);
-    let (z, lam) = point.dual.split_at(m);
-    (x, w, z, lam, point.free_primal[0], &point.free_dual)
+/// The LP's parts of a point: `(x, w | z, λ)`, the ratio `s` and `y`.
+struct Parts<'p> {
+    x: &'p [f64],
+    w: &'p [f64],
+    z: &'p [f64],
+    lam: &'p [f64],
+    s: f64,
+    y: &'p [f64],
+}
+
+impl<'p> Parts<'p> {
+    fn of(point: &'p Point, m: usize) -> Self {
+        let (x, w) = point.primal.split_at(m);
+        let (z, lam) = point.dual.split_at(m);
+        Parts {
+            x,
+            w,
+            z,
+            lam,
+            s: point.free_primal[0],
+            y: &point.free_dual,
+        }
+    }
 }
 
 impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
@@ -238,7 +256,7 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
     fn residuals(&mut self, point: &Point) -> Measures {
         let program = self.program;
         let m = program.m;
-        let (x, w, z, lam, s, y) = parts(point, m);
+        let Parts { x, w, z, lam, s, y } = Parts::of(point, m);
         let normal = &self.normal;
         normal.a_mul(x, &mut self.rp);
         for (r, bi) in self.rp.iter_mut().zip(&self.b) {
@@ -272,7 +290,7 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
     }
 
     fn factor(&mut self, point: &Point) -> Result<(), NormalError> {
-        let (x, w, z, lam, _, _) = parts(point, self.program.m);
+        let Parts { x, w, z, lam, .. } = Parts::of(point, self.program.m);
         let theta: Vec<f64> = x.iter().zip(z).map(|(a, b)| a / b).collect();
         let omega: Vec<f64> = w.iter().zip(lam).map(|(a, b)| a / b).collect();
         self.scaling = Some(self.program.scaling(&mut self.normal, theta, &omega)?);
@@ -287,7 +305,7 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
     ) -> Result<Point, NormalError> {
         let program = self.program;
         let (m, p, n) = (program.m, program.set.len(), self.normal.n_rows);
-        let (x, w, z, lam, _, _) = parts(point, m);
+        let Parts { x, w, z, lam, .. } = Parts::of(point, m);
         let (rxz, rwl) = complementarity.split_at(m);
         let sc = self
             .scaling
