@@ -39,11 +39,6 @@
 //! * [`input`] — input files read with a size cap.
 #![warn(missing_docs)]
 
-// The unit tests' measurements include the integration tests' net
-// generators (`tests/common/nets.rs`), written against `ringmesh::`.
-#[cfg(test)]
-extern crate self as ringmesh;
-
 pub mod algebra;
 pub mod budget;
 pub mod design;

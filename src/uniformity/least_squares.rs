@@ -31,9 +31,7 @@
 //!
 //! `W = diag(w)` is diagonal, so `T = t − W⁻¹Ãᵀμ` and `μ` solves the Schur
 //! complement system `S μ = Ã t − p`, `S = Ã W⁻¹ Ãᵀ + λ I` (3·n_free square, the
-//! sparsity of `D` with 3 × 3 blocks), symmetric positive definite for `λ > 0`,
-//! factored by the interior point's normal-matrix kernel (`ipm/normal.rs`:
-//! `A diag(1/(w ℓ²)) Aᵀ` with its block pattern and ordering).
+//! sparsity of `D` with 3 × 3 blocks), symmetric positive definite for `λ > 0`.
 //! For `λ = 0`, `A` may have dependent rows (a flat node's vertical row, an
 //! infinitesimal mechanism), so `S` is factored with the shift
 //! `max(λ, 1e-12 · max diag S)` and the solution is refined against the unshifted
@@ -78,9 +76,13 @@
 
 use std::time::Instant;
 
-use super::ipm::{IpmSettings, NormalMatrix};
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Side};
+
 use super::{Design, KnobRange, Termination, UniformityError, UniformityProblem, UniformitySolver};
-use crate::fdm::NONE;
+use crate::algebra::Plain;
 
 const SOLVER: &str = "least-squares";
 
@@ -196,11 +198,11 @@ impl UniformitySolver for LeastSquares {
         self.validate()?;
         let lambda = self.lambda.unwrap_or(0.0);
         let mut kkt = Kkt::new(problem, self.other_weight, lambda);
-        let mut factor = kkt.factor(problem)?;
+        let factor = kkt.factor()?;
         let mut t = kkt.targets_n.clone();
         let mut mu = vec![0.0; kkt.n_rows];
-        let mut refine = |kkt: &Kkt, t: &mut [f64], mu: &mut [f64]| {
-            kkt.refine(factor.as_mut(), t, mu, self.tolerance, self.max_refinements)
+        let refine = |kkt: &Kkt, t: &mut [f64], mu: &mut [f64]| {
+            kkt.refine(factor.as_ref(), t, mu, self.tolerance, self.max_refinements)
         };
         let mut refinement = refine(&kkt, &mut t, &mut mu);
         let mut solves = refinement.solves;
@@ -422,37 +424,50 @@ impl Kkt {
         }
     }
 
-    /// Factors `S = Ã W⁻¹ Ãᵀ + shift·I = A diag(1/(w ℓ²)) Aᵀ + shift·I` with
-    /// `shift = max(λ, SHIFT_FLOOR · max diag)` (`None` when there is no free
-    /// node).
-    fn factor(
-        &self,
-        problem: &UniformityProblem,
-    ) -> Result<Option<NormalMatrix<3>>, UniformityError> {
+    /// The lower triangle of `S = Ã W⁻¹ Ãᵀ + shift·I`, the shift a function of
+    /// the largest diagonal entry of `Ã W⁻¹ Ãᵀ`.
+    fn schur(&self, shift: impl Fn(f64) -> f64) -> SparseColMat<usize, f64> {
+        let mut diagonal = vec![0.0; self.n_rows];
+        let mut triplets = Vec::with_capacity(self.n_rows + 21 * self.weights.len());
+        for (k, &w) in self.weights.iter().enumerate() {
+            let entries: Vec<(usize, f64)> = self.column(k).collect();
+            for (a, &(ra, va)) in entries.iter().enumerate() {
+                diagonal[ra] += va * va / w;
+                // Rows ascend within a column: (ra, rb) with b < a is below the diagonal.
+                for &(rb, vb) in &entries[..a] {
+                    triplets.push(Triplet::new(ra, rb, va * vb / w));
+                }
+            }
+        }
+        let max_diagonal = diagonal.iter().copied().fold(0.0, f64::max);
+        let s = shift(max_diagonal);
+        triplets.extend(
+            diagonal
+                .iter()
+                .enumerate()
+                .map(|(r, &d)| Triplet::new(r, r, d + s)),
+        );
+        SparseColMat::try_new_from_triplets(self.n_rows, self.n_rows, &triplets)
+            .expect("indices are in range by construction")
+    }
+
+    /// Factors `S = Ã W⁻¹ Ãᵀ + shift·I` with `shift = max(λ, SHIFT_FLOOR · max diag)`
+    /// (`None` when there is no free node).
+    fn factor(&self) -> Result<Option<Llt<usize, f64>>, UniformityError> {
         if self.n_rows == 0 {
             return Ok(None);
         }
-        let failed = |e: crate::uniformity::ipm::NormalError| UniformityError::SolverFailed {
-            solver: SOLVER,
-            status: format!("Cholesky factorisation of the Schur complement: {e}"),
-        };
-        let (structure, network) = (problem.structure(), problem.network());
-        let free = |i: usize| structure.free_index(i).unwrap_or(NONE);
-        let ends = network.edges.iter().map(|e| e.map(free)).collect();
-        let settings = IpmSettings::default();
-        let mut normal =
-            NormalMatrix::from_cables(self.n_rows / 3, ends, network.edges_vectors(), &settings)
-                .map_err(failed)?;
-        let theta: Vec<f64> = (self.weights.iter().zip(problem.lengths_m()))
-            .map(|(w, l)| 1.0 / (w * l * l))
-            .collect();
         let lambda = self.lambda;
-        normal
-            .factorize_shifted(&theta, |max_diagonal| {
-                lambda.max(SHIFT_FLOOR * max_diagonal)
-            })
-            .map_err(failed)?;
-        Ok(Some(normal))
+        let s = self.schur(|max_diagonal| lambda.max(SHIFT_FLOOR * max_diagonal));
+        let failed = |what: &str, e: String| UniformityError::SolverFailed {
+            solver: SOLVER,
+            status: format!("{what} Cholesky factorisation of the Schur complement: {e}"),
+        };
+        let symbolic = SymbolicLlt::try_new(s.symbolic(), Side::Lower)
+            .map_err(|e| failed("symbolic", e.plain()))?;
+        Llt::try_new_with_symbolic(symbolic, s.as_ref(), Side::Lower)
+            .map(Some)
+            .map_err(|e| failed("numeric", e.plain()))
     }
 
     /// Iterative refinement of `(T, μ)` against the unshifted system, with the
@@ -460,7 +475,7 @@ impl Kkt {
     /// no longer halves the residual.
     fn refine(
         &self,
-        mut factor: Option<&mut NormalMatrix<3>>,
+        factor: Option<&Llt<usize, f64>>,
         t: &mut [f64],
         mu: &mut [f64],
         tolerance: f64,
@@ -473,8 +488,9 @@ impl Kkt {
             let residuals = self.residuals(t, mu);
             let error = residuals.error1.max(residuals.error2);
             let stalled = solves >= 2 && error > 0.5 * previous;
-            let active = error > tolerance && !stalled && solves < max_solves;
-            let Some(factor) = factor.as_deref_mut().filter(|_| active) else {
+            let Some(factor) =
+                factor.filter(|_| error > tolerance && !stalled && solves < max_solves)
+            else {
                 return Refinement {
                     backward_error: error,
                     equilibrium_error: residuals.error2,
@@ -487,10 +503,10 @@ impl Kkt {
             // S Δμ = Ã W⁻¹ r₁ − r₂, ΔT = W⁻¹ (r₁ − Ãᵀ Δμ).
             let w_inv_r1: Vec<f64> = (0..m).map(|k| residuals.r1[k] / self.weights[k]).collect();
             let a_w_inv_r1 = self.a_times(&w_inv_r1);
-            let mut d_mu: Vec<f64> = (0..self.n_rows)
-                .map(|r| a_w_inv_r1[r] - residuals.r2[r])
-                .collect();
-            factor.precondition(&mut d_mu);
+            let mut rhs =
+                Mat::<f64>::from_fn(self.n_rows, 1, |r, _| a_w_inv_r1[r] - residuals.r2[r]);
+            factor.solve_in_place(rhs.as_mut());
+            let d_mu: Vec<f64> = (0..self.n_rows).map(|r| rhs[(r, 0)]).collect();
             let at_d_mu = self.at_times(&d_mu);
             for k in 0..m {
                 t[k] += (residuals.r1[k] - at_d_mu[k]) / self.weights[k];
@@ -702,10 +718,10 @@ mod tests {
         let problem = two_nodes();
         let (delta, lambda) = (1e-3, 0.5);
         let kkt = Kkt::new(&problem, delta, lambda);
-        let mut factor = kkt.factor(&problem).unwrap();
+        let factor = kkt.factor().unwrap();
         let mut t = kkt.targets_n.clone();
         let mut mu = vec![0.0; kkt.n_rows];
-        let refinement = kkt.refine(factor.as_mut(), &mut t, &mut mu, 1e-14, 10);
+        let refinement = kkt.refine(factor.as_ref(), &mut t, &mut mu, 1e-14, 10);
         assert!(refinement.backward_error <= 1e-14, "{refinement:?}");
 
         // (ÃᵀÃ + λW) T = Ãᵀp + λWt, assembled densely from the problem alone.

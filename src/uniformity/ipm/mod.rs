@@ -65,12 +65,9 @@ mod system;
 
 pub(crate) use data::RatioLp;
 pub(crate) use driver::run;
-pub(crate) use error::{IpmError, NormalError};
-pub(crate) use normal::NormalMatrix;
+pub(crate) use error::IpmError;
 pub(crate) use ratio::solve;
 pub(crate) use settings::IpmSettings;
-#[cfg(test)]
-pub(crate) use settings::StepLength;
 pub(crate) use system::{Measures, NewtonSystem, Point, Rhs};
 
 #[cfg(test)]

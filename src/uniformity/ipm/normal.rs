@@ -2,8 +2,7 @@
 //! fill-reducing ordering and symbolic Cholesky factorisation (once), its
 //! numeric factorisation per iteration (scaled to unit diagonal, shifted when a
 //! pivot fails), the products with `A` and `Aᵀ`, and solves with iterative
-//! refinement against the exact `M`. Least squares (`least_squares.rs`)
-//! factors its Schur complement `Ã W⁻¹ Ãᵀ + shift·I` with it.
+//! refinement against the exact `M`.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
@@ -27,7 +26,7 @@ const PAR: Par = Par::Seq;
 
 /// The normal matrix `M = A Θ̃ Aᵀ` (lower triangle, D×D blocks per node pair),
 /// its symbolic factorisation, and the numeric factor of the current iteration.
-pub(crate) struct NormalMatrix<const D: usize> {
+pub(super) struct NormalMatrix<const D: usize> {
     pub(super) n_rows: usize,
     /// Free indices of each cable's ends (`NONE` for a fixed end).
     ends: Vec<[usize; 2]>,
@@ -50,21 +49,14 @@ pub(crate) struct NormalMatrix<const D: usize> {
 
 impl<const D: usize> NormalMatrix<D> {
     pub(super) fn new(lp: &RatioLp<D>, settings: &IpmSettings) -> Result<Self, NormalError> {
-        let ends = lp.ends.iter().map(|e| e.map(|i| i.unwrap_or(NONE)));
-        Self::from_cables(lp.n_free, ends.collect(), lp.vectors.clone(), settings)
-    }
-
-    /// The normal matrix of the cables `ends` (free indices, `NONE` for a
-    /// fixed end) with the edge vectors `u` on `n_free` free nodes: its
-    /// pattern, ordering and symbolic factorisation, and workspaces. Least
-    /// squares (`least_squares.rs`) factors its Schur complement with it.
-    pub(crate) fn from_cables(
-        n_free: usize,
-        ends: Vec<[usize; 2]>,
-        u: Vec<[f64; D]>,
-        settings: &IpmSettings,
-    ) -> Result<Self, NormalError> {
+        let n_free = lp.n_free;
         let n_rows = D * n_free;
+        let u = lp.vectors.clone();
+        let ends: Vec<[usize; 2]> = lp
+            .ends
+            .iter()
+            .map(|e| e.map(|i| i.unwrap_or(NONE)))
+            .collect();
 
         let BlockPattern {
             neighbour,
@@ -130,16 +122,6 @@ impl<const D: usize> NormalMatrix<D> {
 
     /// Fills `M = A diag(theta) Aᵀ`, scales it to unit diagonal and factors it.
     pub(super) fn factorize(&mut self, theta: &[f64]) -> Result<(), NormalError> {
-        self.factorize_shifted(theta, |_| 0.0)
-    }
-
-    /// Fills `M = A diag(theta) Aᵀ + shift(max diag)·I`, scales it to unit
-    /// diagonal and factors it.
-    pub(crate) fn factorize_shifted(
-        &mut self,
-        theta: &[f64],
-        shift: impl Fn(f64) -> f64,
-    ) -> Result<(), NormalError> {
         let values = &mut self.values;
         values.fill(0.0);
         let col_ptr = &self.col_ptr;
@@ -166,11 +148,6 @@ impl<const D: usize> NormalMatrix<D> {
                     }
                 }
             }
-        }
-        let max_diagonal = (0..self.n_rows).fold(0.0, |m, i| values[col_ptr[i]].max(m));
-        let added = shift(max_diagonal);
-        if added != 0.0 {
-            (0..self.n_rows).for_each(|i| values[col_ptr[i]] += added);
         }
         for (i, s) in self.scale.iter_mut().enumerate() {
             let d = values[col_ptr[i]];
@@ -223,7 +200,7 @@ impl<const D: usize> NormalMatrix<D> {
     }
 
     /// `r ← M̂⁻¹ r` with the current (regularised) factor `M̂`.
-    pub(crate) fn precondition(&mut self, r: &mut [f64]) {
+    pub(super) fn precondition(&mut self, r: &mut [f64]) {
         for (v, s) in r.iter_mut().zip(&self.scale) {
             *v *= s;
         }

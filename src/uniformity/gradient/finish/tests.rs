@@ -3,7 +3,6 @@
 
 use super::*;
 use crate::uniformity::gradient::fixtures::pattern;
-use crate::uniformity::ipm::StepLength;
 use crate::uniformity::{Gradient, Lp, UniformityProblem, UniformitySolver};
 
 fn problem(name: &str) -> UniformityProblem {
@@ -119,73 +118,4 @@ fn the_finish_stops_at_its_step_budget_and_converges_within_the_default() {
         full.warnings
     );
     assert!(full.steps > 1 && full.objective < short.objective);
-}
-
-// The net families of issue 38, as the integration tests generate them.
-#[allow(dead_code, unused_imports, clippy::all)]
-#[path = "../../../../tests/common/hexnet.rs"]
-mod hexnet;
-#[allow(dead_code, unused_imports, clippy::all)]
-#[path = "../../../../tests/common/nets.rs"]
-mod nets;
-
-/// The finish's interior-point iterations on the three net families of
-/// issue 38 at `RINGMESH_FINISH_FREE` free nodes (default 10 000), from
-/// `lp`'s optimum shifted by up to ±3 % per cable, with the finish's step
-/// rule (0.99 of the way to the boundary) and the ratio LP's adaptive
-/// fraction (the LP's separate primal and dual steps took 177 iterations
-/// where the common one took 95 on the hexagonal net, and are not tried).
-/// Measurement, not a check: `cargo test
-/// --release --lib finish_iteration_table -- --ignored --nocapture`.
-#[test]
-#[ignore = "measurement: prints a table"]
-fn finish_iteration_table() {
-    let sizes: Vec<usize> = std::env::var("RINGMESH_FINISH_FREE")
-        .unwrap_or_else(|_| "10000".into())
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect();
-    let finish_rule = IpmSettings::finish();
-    let variants = [
-        ("common 0.99", finish_rule),
-        (
-            "common adaptive",
-            IpmSettings {
-                step_length: StepLength::Adaptive,
-                ..finish_rule
-            },
-        ),
-    ];
-    for free in sizes {
-        for family in nets::Family::ALL {
-            let problem = family.problem(nets::rings_for(free));
-            let lp = Lp.solve(&problem).expect("lp");
-            let shift = pattern(lp.q.len(), 3);
-            let q: Vec<f64> =
-                lp.q.iter()
-                    .zip(&shift)
-                    .map(|(q, s)| q * (1.0 + 0.03 * s))
-                    .collect();
-            let gradient = Gradient::default();
-            let objective = Objective::new(&gradient, &problem);
-            for (name, program) in &variants {
-                let start = std::time::Instant::now();
-                let done =
-                    finish(&objective, &q, &FinishSettings::default(), program).expect("finish");
-                eprintln!(
-                    "{:>7} {:>6} free  {:<16} {:>2} programs {:>4} interior iterations ({:.1} each)  J {:.12e}  {:?}  {:.1} s {:?}",
-                    family.name(),
-                    problem.structure().free_nodes().len(),
-                    name,
-                    done.steps,
-                    done.interior_iterations,
-                    done.interior_iterations as f64 / done.steps as f64,
-                    done.objective,
-                    done.termination,
-                    start.elapsed().as_secs_f64(),
-                    done.warnings
-                );
-            }
-        }
-    }
 }
