@@ -9,7 +9,7 @@ mod common;
 
 use common::nets::{rings_for, Family};
 use common::plan_lp;
-use ringmesh::uniformity::{Lp, Route, UniformitySolver};
+use ringmesh::uniformity::{Gradient, Lp, Route, UniformitySolver};
 
 /// The plan interior point's result on `family` at `rings` rows against
 /// clarabel's on the same plan LP.
@@ -88,6 +88,39 @@ fn iteration_table() {
                 reference.iterations,
                 reference.ratio,
                 design.ratio / reference.ratio - 1.0
+            );
+        }
+    }
+}
+
+/// The gradient's exact finish per family at `RINGMESH_FINISH_FREE` free
+/// nodes (default 10 000): its programs and their interior-point iterations
+/// (issue 38, item 4). Measurement, not a check: `cargo test --release
+/// --test ipm_families finish_table -- --ignored --nocapture`.
+#[test]
+#[ignore = "measurement: prints a table"]
+fn finish_table() {
+    let sizes: Vec<usize> = std::env::var("RINGMESH_FINISH_FREE")
+        .unwrap_or_else(|_| "10000".into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    for free in sizes {
+        for family in Family::ALL {
+            let problem = family.problem(rings_for(free));
+            let (design, history) = Gradient::default()
+                .solve_with_history(&problem)
+                .expect("gradient");
+            eprintln!(
+                "{:>7} {:>7} free  {:>2} programs {:>4} interior iterations  ratio {:.10}  {:?} {:.1} s {:?}",
+                family.name(),
+                problem.structure().free_nodes().len(),
+                history.finish_steps,
+                history.finish_interior_iterations,
+                design.ratio,
+                design.termination,
+                design.time_s,
+                design.warnings
             );
         }
     }

@@ -18,6 +18,8 @@ pub struct History {
     pub runs: usize,
     /// Quadratic programs of the exact finish (0 without it).
     pub finish_steps: usize,
+    /// Interior-point iterations of those programs.
+    pub finish_interior_iterations: usize,
     /// With the exact finish, `J` with the exact `ln(Tmax/Tmin)` at the end.
     pub exact_objective: Option<f64>,
 }

@@ -251,6 +251,7 @@ impl Gradient {
             evaluations: 1,
             runs: 0,
             finish_steps: 0,
+            finish_interior_iterations: 0,
             exact_objective: None,
         };
         // A start near the optimum begins at the final sharpness: its point
@@ -339,8 +340,10 @@ impl Gradient {
             }
         }
         if self.exact_finish && termination != Termination::NumericalError {
-            let finished = finish::finish(&objective, &q, &self.finish)?;
+            let program = crate::uniformity::ipm::IpmSettings::finish();
+            let finished = finish::finish(&objective, &q, &self.finish, &program)?;
             history.finish_steps = finished.steps;
+            history.finish_interior_iterations = finished.interior_iterations;
             history.exact_objective = Some(finished.objective);
             warnings.extend(finished.warnings);
             q = finished.q;

@@ -6,6 +6,7 @@
 use super::data::Program;
 use super::error::NormalError;
 use super::normal::NormalMatrix;
+use super::system::Point;
 use crate::algebra::{dot, norm2};
 use crate::fdm::NONE;
 
@@ -24,16 +25,6 @@ pub(super) struct Scaling {
     t: Vec<f64>,
     /// `aᵀ t + γ`.
     schur: f64,
-}
-
-/// A Newton direction.
-pub(super) struct Direction {
-    pub(super) dx: Vec<f64>,
-    pub(super) dz: Vec<f64>,
-    pub(super) dw: Vec<f64>,
-    pub(super) dlam: Vec<f64>,
-    pub(super) dy: Vec<f64>,
-    pub(super) ds: f64,
 }
 
 /// Right-hand sides of the Newton system.
@@ -157,7 +148,8 @@ impl Program {
         (dx, dlam, dy, ds)
     }
 
-    /// One Newton direction for the current iterate: the reduction
+    /// One Newton direction for the current iterate, in the driver's form
+    /// (`dx, dw | dz, dλ | ds | dy`): the reduction
     /// ([`Program::direction_once`]) as a right preconditioner of FGMRES on
     /// the rows it solves only up to the factor's regularisation.
     #[allow(clippy::too_many_arguments)]
@@ -170,7 +162,7 @@ impl Program {
         w: &[f64],
         lam: &[f64],
         rhs: &Rhs,
-    ) -> Direction {
+    ) -> Point {
         let (m, p, n) = (self.m, self.set.len(), normal.n_rows);
         let mut d = self.direction_once(normal, sc, x, z, w, lam, rhs);
         // Measured limitation: on the full 3-D problem, whose `A` has dependent
@@ -203,7 +195,7 @@ impl Program {
         let zero_p = vec![0.0; p];
         r.iter_mut().for_each(|v| *v /= beta);
         let mut basis = vec![r];
-        let mut zs: Vec<Direction> = Vec::new();
+        let mut zs: Vec<Point> = Vec::new();
         let mut h: Vec<Vec<f64>> = Vec::new();
         let (mut cs, mut sn): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
         let mut g = vec![beta];
@@ -275,34 +267,21 @@ impl Program {
             y[i] = v / h[i][i];
         }
         for (zi, yi) in zs.iter().zip(&y) {
-            d.dx.iter_mut().zip(&zi.dx).for_each(|(a, b)| *a += yi * b);
-            d.dz.iter_mut().zip(&zi.dz).for_each(|(a, b)| *a += yi * b);
-            d.dw.iter_mut().zip(&zi.dw).for_each(|(a, b)| *a += yi * b);
-            d.dlam
-                .iter_mut()
-                .zip(&zi.dlam)
-                .for_each(|(a, b)| *a += yi * b);
-            d.dy.iter_mut().zip(&zi.dy).for_each(|(a, b)| *a += yi * b);
-            d.ds += yi * zi.ds;
+            d.add_scaled(*yi, zi);
         }
         d
     }
 
     /// The rows of the Newton system that FGMRES works on, applied to `d`:
     /// `(A dx, dw + E dx − ds e, eᵀdλ)`.
-    fn krylov_rows<const D: usize>(
-        &self,
-        normal: &NormalMatrix<D>,
-        d: &Direction,
-        out: &mut [f64],
-    ) {
-        let n = normal.n_rows;
-        let p = self.set.len();
-        normal.a_mul(&d.dx, &mut out[..n]);
+    fn krylov_rows<const D: usize>(&self, normal: &NormalMatrix<D>, d: &Point, out: &mut [f64]) {
+        let (m, n, p) = (self.m, normal.n_rows, self.set.len());
+        let (dx, dw) = d.primal.split_at(m);
+        normal.a_mul(dx, &mut out[..n]);
         for (j, &k) in self.set.iter().enumerate() {
-            out[n + j] = d.dw[j] + self.lengths[k] * d.dx[k] - d.ds;
+            out[n + j] = dw[j] + self.lengths[k] * dx[k] - d.free_primal[0];
         }
-        out[n + p] = d.dlam.iter().sum();
+        out[n + p] = d.dual[m..].iter().sum();
     }
 
     /// One solve of the Newton system through its reduction.
@@ -316,25 +295,23 @@ impl Program {
         w: &[f64],
         lam: &[f64],
         rhs: &Rhs,
-    ) -> Direction {
+    ) -> Point {
         let g: Vec<f64> = (0..self.m).map(|k| rhs.rxz[k] / x[k] - rhs.rd[k]).collect();
         let h: Vec<f64> = (0..self.set.len())
             .map(|j| rhs.rw[j] + rhs.rwl[j] / lam[j])
             .collect();
-        let (dx, dlam, dy, ds) = self.solve_reduced(normal, sc, &g, &h, rhs.rp, rhs.rs);
-        let dz = (0..self.m)
+        let (mut dx, dlam, dy, ds) = self.solve_reduced(normal, sc, &g, &h, rhs.rp, rhs.rs);
+        let mut dz: Vec<f64> = (0..self.m)
             .map(|k| (rhs.rxz[k] - z[k] * dx[k]) / x[k])
             .collect();
-        let dw = (0..self.set.len())
-            .map(|j| (rhs.rwl[j] - w[j] * dlam[j]) / lam[j])
-            .collect();
-        Direction {
-            dx,
-            dz,
-            dw,
-            dlam,
-            dy,
-            ds,
+        let dw = (0..self.set.len()).map(|j| (rhs.rwl[j] - w[j] * dlam[j]) / lam[j]);
+        dx.extend(dw);
+        dz.extend(dlam);
+        Point {
+            primal: dx,
+            dual: dz,
+            free_primal: vec![ds],
+            free_dual: dy,
         }
     }
 }

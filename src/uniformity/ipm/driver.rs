@@ -1,404 +1,257 @@
-//! The driver: the Mehrotra predictor–corrector iteration from its starting
-//! point to a converged, stalled or failed end, the choice of the best iterate,
-//! and its final projection onto equilibrium.
+//! The driver: the Mehrotra predictor–corrector iteration of any
+//! [`NewtonSystem`] from its starting point to a converged, stalled or
+//! failed end — centring, Gondzio's centrality correctors, the step to the
+//! boundary, the stopping tests and the choice of the best iterate.
 
-use super::data::Program;
-use super::data::RatioLp;
-use super::direction::Rhs;
-use super::error::IpmError;
-use super::normal::NormalMatrix;
-use super::settings::{IpmSettings, Start};
-use super::status::IpmSolution;
-use crate::algebra::{dot, norm_inf};
-use crate::fdm::NONE;
+use super::settings::{IpmSettings, StepLength};
+use super::system::{Measures, NewtonSystem, Point, Rhs};
 use crate::status::Termination;
 
-/// Solves the ratio LP with the structured interior-point method and
-/// `settings`. The returned `q` is unscaled (smallest set tension ≈ 1); the
-/// caller rescales it.
-///
-/// # Errors
-/// A setting out of range, an LP the method does not take (a tension floor
-/// that is not positive, an empty set), or a normal system that cannot be set
-/// up. How the iteration itself ended is the solution's status.
-///
-/// # Panics
-/// If the per-cable vectors of `lp` differ in length.
-pub(crate) fn solve<const D: usize>(
-    lp: &RatioLp<D>,
-    settings: &IpmSettings,
-) -> Result<IpmSolution, IpmError> {
-    settings.validate()?;
-    let program = Program::new(lp, *settings)?;
-    let mut normal = NormalMatrix::new(lp, settings)?;
-    Ok(program.run(&mut normal))
+/// How the iteration ended.
+#[derive(Debug)]
+pub(crate) struct Outcome<E> {
+    /// The best iterate when it was accepted (converged or stalled at
+    /// reduced accuracy), else the last one; `None` when there was no
+    /// starting point.
+    pub point: Option<Point>,
+    /// Iterations.
+    pub iterations: usize,
+    /// How the iteration stopped:
+    /// * `Converged`: residuals and gap below their tolerances;
+    /// * `Stalled`: the iterate stopped improving with residuals and gap
+    ///   below the reduced tolerances (clarabel's `AlmostSolved`): its best
+    ///   iterate, usable at reduced accuracy;
+    /// * `MaxIterations`: the iteration limit came first;
+    /// * `NumericalError`: a factorisation or solve failed, or the iterate
+    ///   stopped being finite.
+    pub termination: Termination,
+    /// The measures of `point`.
+    pub measures: Measures,
+    /// The failure behind a `NumericalError`, when the system reported one.
+    pub error: Option<E>,
 }
 
-/// The best iterate so far, by its largest residual relative to its tolerance.
+/// The best iterate so far, by its largest measure relative to its
+/// tolerance.
 struct Best {
     score: f64,
-    x: Vec<f64>,
+    point: Point,
     iteration: usize,
-    residuals: [f64; 3],
-    max_tension: f64,
+    measures: Measures,
 }
 
-impl Program {
-    /// Projects `q` onto `A q = 0` in the metric of relative changes:
-    /// `q ← q − W Aᵀ (A W Aᵀ)⁻¹ A q`, `W = diag(q²)`, so every cable moves by
-    /// about the residual relative to its own force density (cables at a bound
-    /// stay there to that order). Returns `q` and its relative residual.
-    fn polish<const D: usize>(
-        &self,
-        normal: &mut NormalMatrix<D>,
-        mut q: Vec<f64>,
-        max_tension: f64,
-    ) -> (Vec<f64>, f64) {
-        let n = normal.n_rows;
-        let mut residual = vec![0.0; n];
-        let mut correction = vec![0.0; self.m];
-        let weights: Vec<f64> = q.iter().map(|v| v * v).collect();
-        if normal.factorize(&weights).is_err() {
-            return (q, f64::INFINITY);
-        }
-        for _ in 0..2 {
-            normal.a_mul(&q, &mut residual);
-            if norm_inf(&residual) <= 0.1 * self.settings.polished * max_tension {
-                break;
-            }
-            let v = normal.solve(&weights, &residual);
-            normal.at_mul(&v, &mut correction);
-            for ((qk, ck), wk) in q.iter_mut().zip(&correction).zip(&weights) {
-                *qk -= wk * ck;
-            }
-        }
-        normal.a_mul(&q, &mut residual);
-        (q, norm_inf(&residual) / max_tension)
+/// `Σ_i f(i)` over the pairs, block by block (`ends` from
+/// [`NewtonSystem::pair_blocks`]).
+fn pair_sum(ends: &[usize], f: impl Fn(usize) -> f64) -> f64 {
+    let mut start = 0;
+    let mut sum = 0.0;
+    for (b, &end) in ends.iter().enumerate() {
+        let block: f64 = (start..end).map(&f).sum();
+        sum = if b == 0 { block } else { sum + block };
+        start = end;
     }
+    sum
+}
 
-    fn run<const D: usize>(&self, normal: &mut NormalMatrix<D>) -> IpmSolution {
-        let settings = &self.settings;
-        let m = self.m;
-        let p = self.set.len();
-        let n = normal.n_rows;
-        let n_compl = (m + p) as f64;
-        // b = −A lb.
-        let mut b = vec![0.0; n];
-        normal.a_mul(&self.lower, &mut b);
-        b.iter_mut().for_each(|v| *v = -*v);
+/// Largest step in `[0, cap]` keeping `v + α dv ≥ 0`.
+fn step_to_boundary(v: &[f64], dv: &[f64], cap: f64) -> f64 {
+    v.iter()
+        .zip(dv)
+        .filter(|(_, &d)| d < 0.0)
+        .fold(cap, |alpha, (&v, &d)| alpha.min(-v / d))
+}
 
-        // Starting point (Mehrotra): least-norm primal point with Θ = I, Ω = I,
-        // then shifted into the interior together with the dual; with
-        // `Start::TensionScaled` all of it in tensions above the floor
-        // (`ℓ x`, `z/ℓ`): least norm with `Θ = diag(1/ℓ²)`, one shift for
-        // every tension.
-        let tension_scaled = settings.start == Start::TensionScaled;
-        let theta0: Vec<f64> = if tension_scaled {
-            self.lengths.iter().map(|l| 1.0 / (l * l)).collect()
+/// Runs the interior-point method on `system` with `settings` (checked by
+/// the caller).
+pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Outcome<S::Error> {
+    let mut point = match system.start() {
+        Ok(point) => point,
+        Err(error) => {
+            return Outcome {
+                point: None,
+                iterations: 0,
+                termination: Termination::NumericalError,
+                measures: Measures::NAN,
+                error: Some(error),
+            }
+        }
+    };
+    let ends = system.pair_blocks();
+    let n_pairs = ends.last().copied().unwrap_or(0);
+    let n_compl = n_pairs as f64;
+    let cap = match settings.step_length {
+        StepLength::Adaptive => 1.0,
+        StepLength::Fixed(fraction) => 1.0 / fraction,
+    };
+    // The primal and dual steps to the boundary along `d` (equal when the
+    // steps are common).
+    let steps = |point: &Point, d: &Point| {
+        let primal = step_to_boundary(&point.primal, &d.primal, cap);
+        let dual = step_to_boundary(&point.dual, &d.dual, cap);
+        if settings.separate_steps {
+            (primal, dual)
         } else {
-            vec![1.0; m]
+            (primal.min(dual), primal.min(dual))
+        }
+    };
+    let (pt, dt, gt) = (
+        settings.primal_tolerance,
+        settings.dual_tolerance,
+        settings.gap_tolerance,
+    );
+
+    // Within the reduced tolerances.
+    let reduced = |m: &Measures| {
+        m.primal.max(m.dual) <= settings.reduced_tolerance
+            && m.gap <= settings.reduced_gap_tolerance
+    };
+    let mut measures = Measures::NAN;
+    let mut best: Option<Best> = None;
+    let mut failed = false;
+    let mut error = None;
+    let mut iterations = 0;
+    for iteration in 0..=settings.max_iterations {
+        iterations = iteration;
+        measures = system.residuals(&point);
+        if !measures.is_finite() {
+            failed = true;
+            break;
+        }
+        let converged = measures.primal <= pt && measures.dual <= dt && measures.gap <= gt;
+        let score = (measures.primal / pt)
+            .max(measures.dual / dt)
+            .max(measures.gap / gt);
+        // An iterate within the primal tolerance beats any outside it.
+        let key = (measures.primal > pt, score);
+        let better = |b: &Best| key < (b.measures.primal > pt, b.score);
+        if converged || best.as_ref().is_none_or(better) {
+            best = Some(Best {
+                score,
+                point: point.clone(),
+                iteration,
+                measures,
+            });
+        }
+        // Stalled: the best iterate is usable at reduced accuracy and has
+        // not been bettered for `stall_iterations`. (An infeasible start can
+        // raise the gap for longer than that while its residuals fall: the
+        // finish's programs from a step-free point do.)
+        let stalled = best.as_ref().is_some_and(|b| {
+            reduced(&b.measures) && iteration >= b.iteration + settings.stall_iterations
+        });
+        if converged || stalled || iteration == settings.max_iterations {
+            break;
+        }
+        let (v, u) = (&point.primal, &point.dual);
+        let mu = pair_sum(&ends, |i| v[i] * u[i]) / n_compl;
+        if let Err(e) = system.factor(&point) {
+            (failed, error) = (true, Some(e));
+            break;
+        }
+
+        // Predictor.
+        let r: Vec<f64> = v.iter().zip(u).map(|(a, b)| -a * b).collect();
+        let affine = match system.direction(&point, &r, Rhs::Predictor) {
+            Ok(d) => d,
+            Err(e) => {
+                (failed, error) = (true, Some(e));
+                break;
+            }
         };
-        let (mut x, mut w, mut s) = {
-            let Ok(sc) = self.scaling(normal, theta0, &vec![1.0; p]) else {
-                return IpmSolution {
-                    q: self.lower.clone(),
-                    iterations: 0,
-                    termination: Termination::NumericalError,
-                    residuals: [f64::NAN; 3],
-                };
-            };
-            let (dx, dlam, _, ds) =
-                self.solve_reduced(normal, &sc, &vec![0.0; m], &vec![1.0; p], &b, 0.0);
-            let w: Vec<f64> = dlam.iter().map(|v| -v).collect();
-            (dx, w, ds)
-        };
-        let mut lam = vec![1.0 / p as f64; p];
-        let mut y = vec![0.0; n];
-        let mut z: Vec<f64> = (0..m)
-            .map(|k| match self.in_set[k] {
-                NONE => 0.0,
-                j => self.lengths[k] * lam[j],
-            })
+        let (ap, ad) = steps(&point, &affine);
+        let (dv, du) = (&affine.primal, &affine.dual);
+        let mu_aff = pair_sum(&ends, |i| (v[i] + ap * dv[i]) * (u[i] + ad * du[i])) / n_compl;
+        let sigma = (mu_aff / mu).powi(3).clamp(0.0, 1.0);
+
+        // Corrector.
+        let r: Vec<f64> = (0..n_pairs)
+            .map(|i| sigma * mu - v[i] * u[i] - dv[i] * du[i])
             .collect();
-        if tension_scaled {
-            x.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v *= l);
-            z.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v /= l);
-        }
-        {
-            let min_p = x.iter().chain(&w).fold(f64::INFINITY, |a, &v| a.min(v));
-            let min_d = z.iter().chain(&lam).fold(f64::INFINITY, |a, &v| a.min(v));
-            let dp = (-1.5 * min_p).max(0.0);
-            let dd = (-1.5 * min_d).max(0.0);
-            x.iter_mut().chain(w.iter_mut()).for_each(|v| *v += dp);
-            z.iter_mut().chain(lam.iter_mut()).for_each(|v| *v += dd);
-            let xz = dot(&x, &z) + dot(&w, &lam);
-            let sum_p: f64 = x.iter().chain(&w).sum();
-            let sum_d: f64 = z.iter().chain(&lam).sum();
-            let dp = 0.5 * xz / sum_d;
-            let dd = 0.5 * xz / sum_p;
-            x.iter_mut().chain(w.iter_mut()).for_each(|v| *v += dp);
-            z.iter_mut().chain(lam.iter_mut()).for_each(|v| *v += dd);
-            if tension_scaled {
-                x.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v /= l);
-                z.iter_mut().zip(&self.lengths).for_each(|(v, l)| *v *= l);
-            }
-        }
-
-        let mut rp = vec![0.0; n];
-        let mut rd = vec![0.0; m];
-        let mut rw = vec![0.0; p];
-        let mut aty = vec![0.0; m];
-        let mut residuals = [f64::INFINITY; 3];
-        let mut best: Option<Best> = None;
-        let mut failed = false;
-        let mut iterations = 0;
-        for iteration in 0..=settings.max_iterations {
-            iterations = iteration;
-            // Residuals.
-            normal.a_mul(&x, &mut rp);
-            for (r, bi) in rp.iter_mut().zip(&b) {
-                *r = bi - *r;
-            }
-            normal.at_mul(&y, &mut aty);
-            let mut et_lam_norm = 0.0f64;
-            for k in 0..m {
-                let et = match self.in_set[k] {
-                    NONE => 0.0,
-                    j => self.lengths[k] * lam[j],
-                };
-                et_lam_norm = et_lam_norm.max(et.abs());
-                rd[k] = et - aty[k] - z[k];
-            }
-            for (j, &k) in self.set.iter().enumerate() {
-                rw[j] = w[j] + 1.0 + self.lengths[k] * x[k] - s;
-            }
-            let rs = 1.0 - lam.iter().sum::<f64>();
-            let max_tension = (0..m)
-                .map(|k| self.lengths[k] * (x[k] + self.lower[k]))
-                .fold(0.0, f64::max);
-            let primal = (norm_inf(&rp) / max_tension).max(norm_inf(&rw) / s.abs().max(1.0));
-            let dual_scale = et_lam_norm.max(norm_inf(&aty)).max(norm_inf(&z));
-            let dual = (norm_inf(&rd) / dual_scale).max(rs.abs());
-            let complementarity = dot(&x, &z) + dot(&w, &lam);
-            let gap = complementarity / s.abs().max(1.0);
-            residuals = [primal, dual, gap];
-            if !(primal.is_finite() && dual.is_finite() && gap.is_finite()) {
-                failed = true;
+        let mut d = match system.direction(&point, &r, Rhs::Corrector) {
+            Ok(d) => d,
+            Err(e) => {
+                (failed, error) = (true, Some(e));
                 break;
             }
-            let converged = primal <= settings.primal_tolerance
-                && dual <= settings.tolerance
-                && gap <= settings.tolerance;
-            let score = (primal / settings.primal_tolerance)
-                .max(dual / settings.tolerance)
-                .max(gap / settings.tolerance);
-            // An iterate within the primal tolerance beats any outside it.
-            let key = (primal > settings.primal_tolerance, score);
-            let better = |b: &Best| key < (b.residuals[0] > settings.primal_tolerance, b.score);
-            if converged || best.as_ref().is_none_or(better) {
-                best = Some(Best {
-                    score,
-                    x: x.clone(),
-                    iteration,
-                    residuals,
-                    max_tension,
-                });
-            }
-            let stalled = best
-                .as_ref()
-                .is_some_and(|b| iteration >= b.iteration + settings.stall_iterations);
-            if converged || stalled {
-                break;
-            }
-            if iteration == settings.max_iterations {
-                break;
-            }
-            let mu = complementarity / n_compl;
-
-            // Factor the scaled normal matrix.
-            let theta: Vec<f64> = x.iter().zip(&z).map(|(a, b)| a / b).collect();
-            let omega: Vec<f64> = w.iter().zip(&lam).map(|(a, b)| a / b).collect();
-            let Ok(sc) = self.scaling(normal, theta, &omega) else {
-                failed = true;
-                break;
-            };
-
-            // Predictor.
-            let rxz: Vec<f64> = x.iter().zip(&z).map(|(a, b)| -a * b).collect();
-            let rwl: Vec<f64> = w.iter().zip(&lam).map(|(a, b)| -a * b).collect();
-            // Both directions share the factor and differ in the complementarity rows.
-            let zero_n = vec![0.0; n];
-            let zero_m = vec![0.0; m];
-            let zero_p = vec![0.0; p];
-            // `residuals`: the iterate's own residuals, or zero (a corrector).
-            let mut direction = |rxz: &[f64], rwl: &[f64], residuals: bool| {
-                let (rp, rw, rd, rs) = if residuals {
-                    (&rp[..], &rw[..], &rd[..], rs)
-                } else {
-                    (&zero_n[..], &zero_p[..], &zero_m[..], 0.0)
-                };
-                self.direction(
-                    normal,
-                    &sc,
-                    &x,
-                    &z,
-                    &w,
-                    &lam,
-                    &Rhs {
-                        rp,
-                        rw,
-                        rd,
-                        rs,
-                        rxz,
-                        rwl,
-                    },
-                )
-            };
-            let affine = direction(&rxz, &rwl, true);
-            let ap = max_step(&x, &affine.dx).min(max_step(&w, &affine.dw));
-            let ad = max_step(&z, &affine.dz).min(max_step(&lam, &affine.dlam));
-            let mu_aff = ((0..m)
-                .map(|k| (x[k] + ap * affine.dx[k]) * (z[k] + ad * affine.dz[k]))
-                .sum::<f64>()
-                + (0..p)
-                    .map(|j| (w[j] + ap * affine.dw[j]) * (lam[j] + ad * affine.dlam[j]))
-                    .sum::<f64>())
-                / n_compl;
-            let sigma = (mu_aff / mu).powi(3).clamp(0.0, 1.0);
-
-            // Corrector.
-            let rxz: Vec<f64> = (0..m)
-                .map(|k| sigma * mu - x[k] * z[k] - affine.dx[k] * affine.dz[k])
-                .collect();
-            let rwl: Vec<f64> = (0..p)
-                .map(|j| sigma * mu - w[j] * lam[j] - affine.dw[j] * affine.dlam[j])
-                .collect();
-            let mut d = direction(&rxz, &rwl, true);
-            let steps = |d: &super::direction::Direction| {
-                (
-                    max_step(&x, &d.dx).min(max_step(&w, &d.dw)),
-                    max_step(&z, &d.dz).min(max_step(&lam, &d.dlam)),
-                )
-            };
-            // Gondzio's multiple centrality correctors: aim a longer step at
-            // a point whose complementarity products lie within
-            // [β_min, β_max]·σμ, keep the correction while it lengthens the step.
-            let (mut bp, mut bd) = steps(&d);
-            for _ in 0..settings.centrality_correctors {
-                if bp.min(bd) >= 1.0 {
-                    break;
-                }
-                let tp = (1.5 * bp + 0.1).min(1.0);
-                let td = (1.5 * bd + 0.1).min(1.0);
-                let target = sigma * mu;
-                let (lo, hi) = (0.1 * target, 10.0 * target);
-                let push = |v: f64| {
-                    if v < lo {
-                        lo - v
-                    } else if v > hi {
-                        (hi - v).max(-hi)
-                    } else {
-                        0.0
-                    }
-                };
-                let cxz: Vec<f64> = (0..m)
-                    .map(|k| push((x[k] + tp * d.dx[k]) * (z[k] + td * d.dz[k])))
-                    .collect();
-                let cwl: Vec<f64> = (0..p)
-                    .map(|j| push((w[j] + tp * d.dw[j]) * (lam[j] + td * d.dlam[j])))
-                    .collect();
-                let c = direction(&cxz, &cwl, false);
-                let mut trial = super::direction::Direction {
-                    dx: d.dx.iter().zip(&c.dx).map(|(a, b)| a + b).collect(),
-                    dz: d.dz.iter().zip(&c.dz).map(|(a, b)| a + b).collect(),
-                    dw: d.dw.iter().zip(&c.dw).map(|(a, b)| a + b).collect(),
-                    dlam: d.dlam.iter().zip(&c.dlam).map(|(a, b)| a + b).collect(),
-                    dy: d.dy.iter().zip(&c.dy).map(|(a, b)| a + b).collect(),
-                    ds: d.ds + c.ds,
-                };
-                let (np, nd) = steps(&trial);
-                if np.min(nd) < 1.01 * bp.min(bd) {
-                    break;
-                }
-                std::mem::swap(&mut d, &mut trial);
-                (bp, bd) = (np, nd);
-            }
-            let eta = (1.0 - mu.min(0.1)).clamp(0.9, 0.99995);
-            let ap = (eta * bp).min(1.0);
-            let ad = (eta * bd).min(1.0);
-            let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-            if !(ap.is_finite()
-                && ad.is_finite()
-                && d.ds.is_finite()
-                && finite(&d.dx)
-                && finite(&d.dz)
-                && finite(&d.dy))
-            {
-                failed = true;
-                break;
-            }
-            for k in 0..m {
-                x[k] += ap * d.dx[k];
-                z[k] += ad * d.dz[k];
-            }
-            for j in 0..p {
-                w[j] += ap * d.dw[j];
-                lam[j] += ad * d.dlam[j];
-            }
-            s += ap * d.ds;
-            for (yi, di) in y.iter_mut().zip(&d.dy) {
-                *yi += ad * di;
-            }
-        }
-        // The best iterate: converged, or accepted at reduced accuracy.
-        // At reduced accuracy the primal residual must still be within its own
-        // tolerance: the final projection moves `q` by about that much, and a
-        // score scaled by `tolerance` alone let 1e-5 through (measured: the
-        // ratio of a 2·10⁵-node net off by 1e-3).
-        let Some(best) = best.filter(|b| {
-            b.residuals[0] <= settings.primal_tolerance
-                && b.residuals[1].max(b.residuals[2]) <= settings.reduced_tolerance
-        }) else {
-            return IpmSolution {
-                q: x.iter().zip(&self.lower).map(|(a, l)| a + l).collect(),
-                iterations,
-                termination: if failed {
-                    Termination::NumericalError
-                } else {
-                    Termination::MaxIterations
-                },
-                residuals,
-            };
         };
-        let q: Vec<f64> = best.x.iter().zip(&self.lower).map(|(a, l)| a + l).collect();
-        let (q, primal) = self.polish(normal, q, best.max_tension);
-        let mut residuals = best.residuals;
-        residuals[0] = primal;
-        IpmSolution {
-            q,
+        // Gondzio's multiple centrality correctors: aim a longer step at
+        // a point whose complementarity products lie within
+        // [β_min, β_max]·σμ, keep the correction while it lengthens the step.
+        let (mut bp, mut bd) = steps(&point, &d);
+        for _ in 0..settings.centrality_correctors {
+            if bp.min(bd) >= 1.0 {
+                break;
+            }
+            let tp = (1.5 * bp + 0.1).min(1.0);
+            let td = (1.5 * bd + 0.1).min(1.0);
+            let target = sigma * mu;
+            let (lo, hi) = (0.1 * target, 10.0 * target);
+            let push = |v: f64| {
+                if v < lo {
+                    lo - v
+                } else if v > hi {
+                    (hi - v).max(-hi)
+                } else {
+                    0.0
+                }
+            };
+            let r: Vec<f64> = (0..n_pairs)
+                .map(|i| push((v[i] + tp * d.primal[i]) * (u[i] + td * d.dual[i])))
+                .collect();
+            let Ok(c) = system.direction(&point, &r, Rhs::Centrality) else {
+                break;
+            };
+            let mut trial = d.clone();
+            trial.add_scaled(1.0, &c);
+            let (np, nd) = steps(&point, &trial);
+            if np.min(nd) < 1.01 * bp.min(bd) {
+                break;
+            }
+            d = trial;
+            (bp, bd) = (np, nd);
+        }
+        let fraction = match settings.step_length {
+            StepLength::Adaptive => (1.0 - mu.min(0.1)).clamp(0.9, 0.99995),
+            StepLength::Fixed(fraction) => fraction,
+        };
+        let ap = (fraction * bp).min(1.0);
+        let ad = (fraction * bd).min(1.0);
+        if !(ap.is_finite() && ad.is_finite() && d.is_finite()) {
+            failed = true;
+            break;
+        }
+        let add = |x: &mut [f64], dx: &[f64], alpha: f64| {
+            x.iter_mut().zip(dx).for_each(|(x, d)| *x += alpha * d);
+        };
+        add(&mut point.primal, &d.primal, ap);
+        add(&mut point.dual, &d.dual, ad);
+        add(&mut point.free_primal, &d.free_primal, ap);
+        add(&mut point.free_dual, &d.free_dual, ad);
+    }
+    // The best iterate: converged, or accepted at reduced accuracy.
+    let accepted = best.filter(|b| reduced(&b.measures));
+    match accepted {
+        Some(best) => Outcome {
+            point: Some(best.point),
             iterations,
-            termination: if primal > settings.polished {
-                Termination::NumericalError
-            } else if best.score <= 1.0 {
+            termination: if best.score <= 1.0 {
                 Termination::Converged
             } else {
                 Termination::Stalled
             },
-            residuals,
-        }
-    }
-}
-
-/// Largest step in `[0, 1]` keeping `v + α dv ≥ 0`.
-fn max_step(v: &[f64], dv: &[f64]) -> f64 {
-    v.iter().zip(dv).fold(
-        1.0f64,
-        |alpha, (&vi, &di)| {
-            if di < 0.0 {
-                alpha.min(-vi / di)
-            } else {
-                alpha
-            }
+            measures: best.measures,
+            error,
         },
-    )
+        None => Outcome {
+            point: Some(point),
+            iterations,
+            termination: if failed {
+                Termination::NumericalError
+            } else {
+                Termination::MaxIterations
+            },
+            measures,
+            error,
+        },
+    }
 }

@@ -39,24 +39,36 @@
 //! measures residuals of `A Θ Aᵀ dy` with `Θ` spanning ~10^±20 near the optimum
 //! and loses the primal residual there (the run stalled at 3·10⁴ nodes).
 //!
-//! The files follow Clarabel's `solver/core`: [`IpmSettings`] (`settings.rs`),
-//! the LP and its kernel form (`data.rs`), the normal system and its
-//! factorisation (`normal.rs`), the Newton direction with its FGMRES completion
-//! (`direction.rs`), the Mehrotra iteration (`driver.rs`), what it returns
-//! (`status.rs`), and why it could not start (`error.rs`, below the others).
+//! One interior point runs every program of the crate that needs one: the
+//! driver (`driver.rs`) is generic over the problem's Newton system
+//! ([`NewtonSystem`], `system.rs`) as clarabel's solver is over its
+//! `KKTSolver`. It owns the Mehrotra predictor–corrector, the step to the
+//! boundary, the centrality correctors, the stopping tests and the status;
+//! the problem owns its variables, start, residuals and linear algebra. The
+//! ratio LP above is one problem (`ratio.rs`, with its data in `data.rs`,
+//! the normal system and its factorisation in `normal.rs`, the Newton
+//! direction with its FGMRES completion in `direction.rs`); the exact
+//! finish's quadratic program is the other (`gradient/finish/ipm.rs`). One
+//! settings struct ([`IpmSettings`], `settings.rs`) serves both, what the LP
+//! returns is `status.rs`'s, and why it could not start is `error.rs`'s
+//! (below the others).
 
 mod data;
 mod direction;
 mod driver;
 mod error;
 mod normal;
+mod ratio;
 mod settings;
 mod status;
+mod system;
 
 pub(crate) use data::RatioLp;
-pub(crate) use driver::solve;
+pub(crate) use driver::run;
 pub(crate) use error::IpmError;
+pub(crate) use ratio::solve;
 pub(crate) use settings::IpmSettings;
+pub(crate) use system::{Measures, NewtonSystem, Point, Rhs};
 
 #[cfg(test)]
 pub(crate) mod tests;

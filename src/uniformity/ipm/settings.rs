@@ -1,12 +1,15 @@
-//! The interior-point method's tuning as plain data: the tolerances and limits
-//! of the Mehrotra iteration, the regularisation and refinement of the normal
-//! system, the FGMRES completion of a Newton direction, and the one check of
-//! their ranges ([`IpmSettings::validate`]).
+//! The interior-point method's tuning as plain data, for every problem the
+//! driver runs (the ratio LP of `lp.rs`/`plan.rs`, the exact finish's
+//! quadratic program): the stopping tests and limits of the Mehrotra
+//! iteration, its step rule, the regularisation and refinement of the
+//! problems' Newton systems, the FGMRES completion of the plan LP, the
+//! finish's start, and the one check of their ranges
+//! ([`IpmSettings::validate`]).
 
 use super::IpmError;
 
-/// How the starting point is scaled (issue 38, measured on three net
-/// families: `tests/ipm_families.rs`).
+/// How the ratio LP's starting point is scaled (issue 38, measured on three
+/// net families: `tests/ipm_families.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Start {
     /// Mehrotra's heuristic in the LP's own variables `x = q − lb`: least norm
@@ -19,81 +22,139 @@ pub(crate) enum Start {
     TensionScaled,
 }
 
-/// Tolerances, limits and regularisation of the interior-point method;
-/// [`Default`] holds the values it is tuned with.
+/// The fraction `τ` of the step to the boundary that an iteration takes:
+/// the step is `min(1, τ α)`, `α` the largest step that keeps the pairs
+/// non-negative, capped at `1/τ`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum StepLength {
+    /// `τ = clamp(1 − min(μ, 0.1), 0.9, 0.99995)`, `α` capped at 1: short
+    /// steps far from the optimum, nearly full ones close to it (the ratio
+    /// LP's).
+    Adaptive,
+    /// A fixed `τ` in `(0, 1)`, `α` capped at `1/τ` so that a full step is
+    /// taken where the boundary is beyond it.
+    Fixed(f64),
+}
+
+/// Tolerances, limits, step rule and linear algebra of the interior-point
+/// method; [`Default`] holds the values of the full (3-D) ratio LP, with
+/// [`IpmSettings::plan`] and [`IpmSettings::finish`] the other problems'.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct IpmSettings {
-    /// Relative tolerance on the dual residual and the duality gap.
-    pub tolerance: f64,
-    /// Relative primal residual accepted before the final projection (the
-    /// driver's `polish`), which restores equilibrium to rounding: near the
-    /// optimum `Θ = X Z⁻¹` spans some twenty orders of magnitude and the
-    /// normal equations no longer resolve the primal residual, while the gap
-    /// and the dual residual still converge.
+    /// Relative primal residual at which the method has converged. The
+    /// ratio LP projects its point onto equilibrium afterwards (its
+    /// `polish`), which restores it to rounding: near the optimum `Θ = X
+    /// Z⁻¹` spans some twenty orders of magnitude and the normal equations
+    /// no longer resolve the primal residual, while the gap and the dual
+    /// residual still converge.
     pub primal_tolerance: f64,
-    /// Residuals and gap of an iterate accepted at reduced accuracy when the
-    /// method stalls.
+    /// Relative dual residual at which the method has converged.
+    pub dual_tolerance: f64,
+    /// Relative duality gap at which the method has converged (each problem
+    /// states what the gap is relative to).
+    pub gap_tolerance: f64,
+    /// Primal and dual residuals of a best iterate accepted at reduced
+    /// accuracy when the method stalls (clarabel's `AlmostSolved`); for the
+    /// ratio LP at most its primal tolerance, which the projection needs.
     pub reduced_tolerance: f64,
+    /// The gap of such an iterate.
+    pub reduced_gap_tolerance: f64,
     /// Iterations without a better iterate after which the method counts as
     /// stalled.
     pub stall_iterations: usize,
-    /// Relative primal residual after the final projection.
-    pub polished: f64,
     /// Iteration limit.
     pub max_iterations: usize,
-    /// Pivots of the unit-diagonal normal matrix below this are treated as
-    /// zero …
-    pub pivot_epsilon: f64,
-    /// … and replaced by this, which drops the direction (dependent rows of
-    /// `A`).
-    pub pivot_delta: f64,
-    /// Added to the unit diagonal of the normal matrix before it is factored.
-    /// Cable nets are mechanisms (`A` has dependent rows: the infinitesimal
-    /// mechanisms a prestress stiffens), so `M` is singular; the shift makes
-    /// the factor well defined, and iterative refinement against the exact `M`
-    /// removes its effect on the range, where every right-hand side lives.
-    pub regularization: f64,
-    /// Largest shift tried when a factorisation fails …
-    pub max_regularization: f64,
-    /// … the shift growing by this factor per failed attempt.
-    pub regularization_growth: f64,
-    /// Refinement steps per solve with the normal matrix (at most) …
-    pub refinement_steps: usize,
-    /// … and their relative residual target.
-    pub refinement_tolerance: f64,
-    /// FGMRES steps per Newton direction (at most) …
-    pub krylov_steps: usize,
-    /// … and their target for the rows the factor solves inexactly, relative
-    /// to their right-hand side.
-    pub krylov_tolerance: f64,
-    /// The starting point's scaling.
-    pub start: Start,
+    /// The fraction of the step to the boundary taken.
+    pub step_length: StepLength,
+    /// Separate step lengths for the primal and the dual variables (the
+    /// LP's); one common step otherwise (a quadratic program's dual residual
+    /// depends on the primal step).
+    pub separate_steps: bool,
     /// Gondzio's centrality correctors per iteration (at most; each is one
     /// more Newton solve with the iteration's factor, kept while it lengthens
     /// the step by 1 %).
     pub centrality_correctors: usize,
+    /// The ratio LP's starting point.
+    pub start: Start,
+    /// Relative primal residual of the ratio LP after its final projection.
+    pub polished: f64,
+    /// Pivots of the scaled Newton matrix below this are treated as zero …
+    pub pivot_epsilon: f64,
+    /// … and replaced by this (with the pivot's expected sign, for the
+    /// quasi-definite matrix of the finish). Above 1 it drops the direction
+    /// (dependent rows of the 3-D LP's `A`).
+    pub pivot_delta: f64,
+    /// Static shift of the unit diagonal of the scaled Newton matrix before
+    /// it is factored. Cable nets are mechanisms (`A` has dependent rows: the
+    /// infinitesimal mechanisms a prestress stiffens), so the LP's `M` is
+    /// singular; the shift makes the factor well defined, and iterative
+    /// refinement against the exact matrix removes its effect on the range,
+    /// where every right-hand side lives.
+    pub regularization: f64,
+    /// Largest shift tried when a factorisation fails (the ratio LP) …
+    pub max_regularization: f64,
+    /// … the shift growing by this factor per failed attempt.
+    pub regularization_growth: f64,
+    /// Least diagonal of the finish's cable unknowns in its factored system
+    /// (a primal regularisation, refined away).
+    pub primal_floor: f64,
+    /// Refinement steps per solve with the factor (at most) …
+    pub refinement_steps: usize,
+    /// … of the predictor, which only sets the centring (the finish) …
+    pub predictor_refinement_steps: usize,
+    /// … and their relative residual target.
+    pub refinement_tolerance: f64,
+    /// FGMRES steps per Newton direction of the plan LP (at most) …
+    pub krylov_steps: usize,
+    /// … and their target for the rows the factor solves inexactly, relative
+    /// to their right-hand side.
+    pub krylov_tolerance: f64,
+    /// The finish's least first slack of a row (the rows are in units of
+    /// `ln T` and of relative `δq`): 0.1 took 10 iterations a program where
+    /// 1 took 13.
+    pub first_slack: f64,
+    /// The finish's least first multiplier of a warm start. The sets' rows
+    /// keep their activity from one step to the next: on the tied nets a
+    /// warm program takes 5–7 iterations against 7–11 cold; below 1e-4 it
+    /// can stall.
+    pub warm_floor: f64,
+    /// A finish program that lowers the model by `Δ` is solved once its gap
+    /// is below this times `Δ` (and its residuals converged): its step is
+    /// then known to a thousandth of its decrease, which is all the finish
+    /// reads from it; only a program that predicts (almost) no decrease —
+    /// the certificate — is solved to [`Self::gap_tolerance`].
+    pub coarse_gap: f64,
 }
 
 impl Default for IpmSettings {
     fn default() -> Self {
         IpmSettings {
-            tolerance: 1e-9,
             primal_tolerance: 1e-6,
+            dual_tolerance: 1e-9,
+            gap_tolerance: 1e-9,
             reduced_tolerance: 1e-6,
+            reduced_gap_tolerance: 1e-6,
             stall_iterations: 8,
-            polished: 1e-12,
             max_iterations: 100,
+            step_length: StepLength::Adaptive,
+            separate_steps: true,
+            centrality_correctors: 0,
+            start: Start::Unscaled,
+            polished: 1e-12,
             pivot_epsilon: 1e-13,
             pivot_delta: 1e64,
             regularization: 1e-14,
             max_regularization: 1e-6,
             regularization_growth: 100.0,
+            primal_floor: 1e-8,
             refinement_steps: 20,
+            predictor_refinement_steps: 20,
             refinement_tolerance: 1e-12,
             krylov_steps: 8,
             krylov_tolerance: 1e-13,
-            start: Start::Unscaled,
-            centrality_correctors: 0,
+            first_slack: 0.1,
+            warm_floor: 1e-4,
+            coarse_gap: 1e-3,
         }
     }
 }
@@ -126,56 +187,115 @@ impl IpmSettings {
         }
     }
 
+    /// The settings of the exact finish's quadratic program
+    /// (`gradient/finish/ipm.rs`): residuals to 1e-8 (clarabel's default),
+    /// the gap to 1e-10 of `max(1, |f|)` — the finish compares the model's
+    /// optimum with `J` to `10⁻⁹ J` — or [`Self::coarse_gap`] of the decrease;
+    /// a program that stalls is accepted with residuals to 1e-6 (they can
+    /// stall a little above 1e-8 at the edge of the directions' precision,
+    /// 2–5e-8 on realistic-26m in the design loop, and the finish reads the
+    /// point only after re-solving its equilibrium). One common step, 0.99
+    /// of the way to the boundary; an LDLᵀ of the quasi-definite reduced
+    /// system with a static shift of 1e-10 and pivots below 1e-13 replaced
+    /// by ±1e-8, refined to a backward error of 1e-10 (0 steps for the
+    /// predictor).
+    pub(crate) fn finish() -> Self {
+        IpmSettings {
+            primal_tolerance: 1e-8,
+            dual_tolerance: 1e-8,
+            gap_tolerance: 1e-10,
+            reduced_tolerance: 1e-6,
+            reduced_gap_tolerance: 1e-10,
+            stall_iterations: 10,
+            max_iterations: 80,
+            step_length: StepLength::Fixed(0.99),
+            separate_steps: false,
+            pivot_delta: 1e-8,
+            regularization: 1e-10,
+            refinement_steps: 30,
+            predictor_refinement_steps: 0,
+            refinement_tolerance: 1e-10,
+            ..IpmSettings::default()
+        }
+    }
+
     /// Checks every setting's range: the tolerances, the pivot threshold and
-    /// the shifts in `(0, 1)`, the shift bound at least the first shift, a
-    /// growth above 1, a replacement pivot above 1, and at least one stall
+    /// the shifts in `(0, 1)`, the reduced tolerances at least the ones they
+    /// relax, the shift bound at least the first shift, a growth above 1, a
+    /// positive replacement pivot, a fixed step fraction in `(0, 1)`, a
+    /// positive first slack and warm floor, and at least one stall
     /// iteration.
+    ///
+    /// # Errors
+    /// [`IpmError::Setting`] naming the first field out of its range.
     pub(crate) fn validate(&self) -> Result<(), IpmError> {
+        let bad = |name: &'static str, value: f64, range: &'static str| {
+            Err(IpmError::Setting { name, value, range })
+        };
         let fractions = [
-            ("tolerance", self.tolerance),
             ("primal_tolerance", self.primal_tolerance),
+            ("dual_tolerance", self.dual_tolerance),
+            ("gap_tolerance", self.gap_tolerance),
             ("reduced_tolerance", self.reduced_tolerance),
+            ("reduced_gap_tolerance", self.reduced_gap_tolerance),
             ("polished", self.polished),
             ("pivot_epsilon", self.pivot_epsilon),
             ("regularization", self.regularization),
             ("max_regularization", self.max_regularization),
+            ("primal_floor", self.primal_floor),
             ("refinement_tolerance", self.refinement_tolerance),
             ("krylov_tolerance", self.krylov_tolerance),
+            ("coarse_gap", self.coarse_gap),
         ];
         for (name, value) in fractions {
             if !(value > 0.0 && value < 1.0) {
-                return Err(IpmError::Setting {
-                    name,
-                    value,
-                    range: "in (0, 1)",
-                });
+                return bad(name, value, "in (0, 1)");
             }
         }
+        if self.reduced_tolerance < self.primal_tolerance.max(self.dual_tolerance) {
+            return bad(
+                "reduced_tolerance",
+                self.reduced_tolerance,
+                "≥ primal_tolerance and dual_tolerance",
+            );
+        }
+        if self.reduced_gap_tolerance < self.gap_tolerance {
+            return bad(
+                "reduced_gap_tolerance",
+                self.reduced_gap_tolerance,
+                "≥ gap_tolerance",
+            );
+        }
         if self.max_regularization < self.regularization {
-            return Err(IpmError::Setting {
-                name: "max_regularization",
-                value: self.max_regularization,
-                range: "≥ regularization",
-            });
+            return bad(
+                "max_regularization",
+                self.max_regularization,
+                "≥ regularization",
+            );
+        }
+        if !(self.regularization_growth.is_finite() && self.regularization_growth > 1.0) {
+            return bad(
+                "regularization_growth",
+                self.regularization_growth,
+                "finite and > 1",
+            );
         }
         for (name, value) in [
-            ("regularization_growth", self.regularization_growth),
             ("pivot_delta", self.pivot_delta),
+            ("first_slack", self.first_slack),
+            ("warm_floor", self.warm_floor),
         ] {
-            if !(value.is_finite() && value > 1.0) {
-                return Err(IpmError::Setting {
-                    name,
-                    value,
-                    range: "finite and > 1",
-                });
+            if !(value.is_finite() && value > 0.0) {
+                return bad(name, value, "finite and > 0");
+            }
+        }
+        if let StepLength::Fixed(fraction) = self.step_length {
+            if !(fraction > 0.0 && fraction < 1.0) {
+                return bad("step_length", fraction, "in (0, 1)");
             }
         }
         if self.stall_iterations == 0 {
-            return Err(IpmError::Setting {
-                name: "stall_iterations",
-                value: 0.0,
-                range: "≥ 1",
-            });
+            return bad("stall_iterations", 0.0, "≥ 1");
         }
         Ok(())
     }

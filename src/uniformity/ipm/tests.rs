@@ -95,10 +95,10 @@ fn settings_out_of_range_are_named() {
     for (settings, name) in [
         (
             IpmSettings {
-                tolerance: 0.0,
+                gap_tolerance: 0.0,
                 ..IpmSettings::default()
             },
-            "tolerance",
+            "gap_tolerance",
         ),
         (
             IpmSettings {

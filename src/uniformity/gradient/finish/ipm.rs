@@ -1,217 +1,279 @@
-//! A primal–dual interior point (Mehrotra predictor–corrector) for the
-//! step's quadratic program, on its structure:
+//! The step's quadratic program as a [`NewtonSystem`] of the crate's
+//! interior point (`uniformity/ipm`, which owns the Mehrotra iteration, its
+//! step rule and stopping tests), on the program's structure:
 //!
 //! ```text
 //! min ½ zᵀHz + cᵀz   s.t.   E z = 0,   G z + s = h,  s ≥ 0,
 //! ```
 //!
 //! `E` the linearised equilibrium of the free nodes, `G` the rows of the
-//! box `lo ≤ p_k ≤ hi` and of the set bounds `l_g ≤ s_k + δs_k ≤ u_g`. Each
-//! Newton system is solved by `kkt.rs` (reduced to the node graph) and
-//! refined against the exact operator `[H + GᵀDG, Eᵀ; E, 0]`. It starts
-//! from `z = 0` with the bounds at the set's extremes, infeasible in the
-//! slacks only, with the previous step's multipliers where given. It stops
-//! when the residuals are below [`FEASIBILITY`] (or, once they have stalled,
-//! below [`REDUCED_FEASIBILITY`]) and the gap below
-//! [`TOLERANCE`]`·max(1, |f|)` — the finish compares the model's optimum
-//! with `J` to `10⁻⁹ J` — or below [`COARSE`] times the decrease the
-//! program makes.
+//! box `lo ≤ p_k ≤ hi` and of the set bounds `l_g ≤ s_k + δs_k ≤ u_g`. The
+//! pairs are the slacks `s` and their multipliers `λ`; `z` takes the primal
+//! step, `y` (for `E z = 0`) the dual one. Each Newton system is solved by
+//! `kkt.rs` (reduced to the node graph) and refined against the exact
+//! operator `[H + GᵀDG, Eᵀ; E, 0]`. It starts from `z = 0` with the bounds
+//! at the set's extremes, infeasible in the slacks only, with the previous
+//! step's multipliers where given. Its residuals are relative to `‖h‖∞` and
+//! `‖c‖∞` (at least 1), its gap to `max(1, |f|)` or, when `coarse`, to the
+//! decrease the program makes ([`IpmSettings::coarse_gap`]); the tolerances
+//! are [`IpmSettings::finish`]'s.
 
 use super::kkt::{Kkt, KktError, RowWeights};
 use super::model::StepModel;
 use crate::algebra::norm_inf;
-
-/// Relative residuals at which the program is solved (clarabel's default).
-const FEASIBILITY: f64 = 1e-8;
-/// Relative residuals at which a program whose residuals have stopped
-/// falling is taken as solved: at the edge of the directions' precision
-/// they can stall a little above [`FEASIBILITY`] (2–5e-8 on realistic-26m
-/// in the design loop) and then drift away. The finish reads the point only
-/// after re-solving its equilibrium ([`StepModel::feasible_point`]).
-const REDUCED_FEASIBILITY: f64 = 1e-6;
-/// Iterations over which the residuals must halve not to have stalled.
-const STALL_ITERATIONS: usize = 10;
-/// Gap, relative to `max(1, |f|)`, at which the program is solved.
-const TOLERANCE: f64 = 1e-10;
-/// Most interior-point iterations.
-const MAX_ITERATIONS: usize = 80;
-/// Most refinement steps of one Newton solve.
-const REFINEMENT_STEPS: usize = 30;
-/// The backward error at which refinement stops: each block's residual
-/// relative to the size of its terms. The interior point asks its residuals
-/// for [`FEASIBILITY`]; a direction this accurate leaves them unchanged to
-/// a hundredth of that.
-const REFINED: f64 = 1e-10;
-/// Refinement steps of the predictor, which only sets the centring.
-const PREDICTOR_REFINEMENT: usize = 0;
-/// A program that lowers the model by `Δ` is solved once its gap is below
-/// `COARSE·Δ`: its step is then known to a thousandth of its decrease,
-/// which is all the finish reads from it; only a program that predicts
-/// (almost) no decrease — the certificate — is solved to [`TOLERANCE`].
-const COARSE: f64 = 1e-3;
-/// The least first slack of a row (the rows are in units of `ln T` and of
-/// relative `δq`): 0.1 took 10 iterations a program where 1 took 13.
-const FIRST_SLACK: f64 = 0.1;
-/// The least first multiplier of a warm start. The sets' rows keep their
-/// activity from one step to the next: on the tied nets a warm program
-/// takes 5–7 iterations against 7–11 cold; below 1e-4 it can stall.
-const WARM_FLOOR: f64 = 1e-4;
-/// Fraction of the step to the boundary taken.
-const STEP_FRACTION: f64 = 0.99;
+use crate::status::Termination;
+use crate::uniformity::ipm::{self, IpmSettings, Measures, NewtonSystem, Point, Rhs};
 
 /// Why the interior point did not reach the program's optimum (the finish
 /// then asks clarabel).
 #[derive(Debug, thiserror::Error)]
 pub(super) enum ProgramError {
-    /// The reduced Newton system could not be set up, factored or solved.
+    /// A setting is out of its range.
+    #[error(transparent)]
+    Settings(#[from] ipm::IpmError),
+    /// The reduced Newton system could not be set up.
     #[error(transparent)]
     Kkt(#[from] KktError),
-    /// The residuals or the gap stopped being finite numbers.
-    #[error("non-finite iterate at iteration {iteration}")]
-    NonFinite {
-        /// The interior-point iteration.
-        iteration: usize,
-    },
-    /// The iteration limit came first.
-    #[error("the step's program did not converge in {iterations} interior-point iterations")]
-    MaxIterations {
-        /// The limit, [`MAX_ITERATIONS`].
+    /// The iteration ended without the program's optimum.
+    #[error(
+        "the step's program ended {termination:?} after {iterations} interior-point iterations{}",
+        cause.as_ref().map(|e| format!(" ({e})")).unwrap_or_default()
+    )]
+    Unsolved {
+        /// How the iteration ended.
+        termination: Termination,
+        /// Its iterations.
         iterations: usize,
+        /// The factorisation or solve that failed, if one did.
+        cause: Option<KktError>,
     },
 }
 
+/// The program's solution.
+pub(super) struct Solved {
+    /// The optimum `z`.
+    pub(super) z: Vec<f64>,
+    /// The multipliers `λ` of its rows.
+    pub(super) lambda: Vec<f64>,
+    /// Interior-point iterations.
+    pub(super) iterations: usize,
+}
+
 /// The program's optimum `z` and the multipliers `λ` of its rows, or why it
-/// was not reached. `warm`: the multipliers of the previous program of the
-/// same rows (the step before), the first `λ` where given; `coarse`: stop
-/// at [`COARSE`] times the decrease from the start (the step-free point)
-/// where that comes first, else always at [`TOLERANCE`].
+/// was not reached, with `settings` ([`IpmSettings::finish`]'s unless a
+/// test says otherwise). `warm`: the multipliers of the previous program of
+/// the same rows (the step before), the first `λ` where given; `coarse`:
+/// stop at [`IpmSettings::coarse_gap`] times the decrease from the start
+/// (the step-free point) where that comes first, else always at the gap
+/// tolerance.
 pub(super) fn solve(
     model: &StepModel,
     warm: Option<&[f64]>,
     coarse: bool,
-) -> Result<(Vec<f64>, Vec<f64>), ProgramError> {
+    settings: &IpmSettings,
+) -> Result<Solved, ProgramError> {
+    settings.validate()?;
     let rows = Rows::new(model);
-    let mut kkt = Kkt::new(model)?;
+    let kkt = Kkt::new(model, settings)?;
     let n = model.n();
     let n_rows = rows.len();
     let n_eq = 3 * model.n_free;
-
-    // Start: z = 0 with each set's bounds at its extremes.
-    let mut z = vec![0.0; n];
-    let at = model.at_bounds();
-    for (g, set) in model.sets.iter().enumerate() {
-        let s = set.iter().map(|&(_, s)| s);
-        z[at + 2 * g] = s.clone().fold(f64::NEG_INFINITY, f64::max);
-        z[at + 2 * g + 1] = s.fold(f64::INFINITY, f64::min);
-    }
-    // The start is the step-free point, feasible but for the slacks.
-    let reference = if coarse {
-        model.value(&z)
-    } else {
-        f64::NEG_INFINITY
-    };
-    let gz = rows.mul(&z);
-    let mut s: Vec<f64> = rows
-        .h
-        .iter()
-        .zip(&gz)
-        .map(|(h, g)| (h - g).max(FIRST_SLACK))
-        .collect();
-    let mut lambda = match warm {
-        Some(w) if w.len() == n_rows => w.iter().map(|&l| l.max(WARM_FLOOR)).collect(),
-        _ => rows.cold_multipliers(),
-    };
-    let mut y = vec![0.0; n_eq];
     let c_norm = norm_inf(&model.gradient(&vec![0.0; n])).max(1.0);
     let h_norm = norm_inf(&rows.h).max(1.0);
-    // max(primal, dual) residual per iteration.
-    let mut residuals = Vec::with_capacity(MAX_ITERATIONS);
+    let mut system = QpSystem {
+        model,
+        rows,
+        kkt,
+        settings: *settings,
+        warm,
+        reference: f64::NEG_INFINITY,
+        coarse,
+        c_norm,
+        h_norm,
+        r_dual: vec![0.0; n],
+        r_eq: vec![0.0; n_eq],
+        r_rows: vec![0.0; n_rows],
+        d: vec![0.0; n_rows],
+    };
+    let outcome = ipm::run(&mut system, settings);
+    match (outcome.termination, outcome.point) {
+        (Termination::Converged | Termination::Stalled, Some(point)) => Ok(Solved {
+            z: point.free_primal,
+            lambda: point.dual,
+            iterations: outcome.iterations,
+        }),
+        (termination, _) => Err(ProgramError::Unsolved {
+            termination,
+            iterations: outcome.iterations,
+            cause: outcome.error,
+        }),
+    }
+}
 
-    for iteration in 0..MAX_ITERATIONS {
-        // Residuals.
-        let mut r_dual = model.gradient(&z);
-        model.equilibrium_transpose_mul(&y, &mut r_dual);
-        rows.add_transpose_mul(&lambda, &mut r_dual);
-        let mut r_eq = vec![0.0; n_eq];
-        model.equilibrium_mul(&z, &mut r_eq);
-        let gz = rows.mul(&z);
-        let r_rows: Vec<f64> = (0..n_rows).map(|i| gz[i] + s[i] - rows.h[i]).collect();
-        let gap: f64 = s.iter().zip(&lambda).map(|(s, l)| s * l).sum();
-        let f = model.value(&z);
-        let primal = norm_inf(&r_eq).max(norm_inf(&r_rows)) / h_norm;
-        let dual = norm_inf(&r_dual) / c_norm;
-        if !(primal.is_finite() && dual.is_finite() && gap.is_finite()) {
-            return Err(ProgramError::NonFinite { iteration });
+/// The program in the driver's form (see the module documentation), with
+/// the residuals of the current iterate and the weights `λ/s` of the last
+/// factorisation.
+struct QpSystem<'a, 'w> {
+    model: &'a StepModel,
+    rows: Rows<'a>,
+    kkt: Kkt<'a>,
+    settings: IpmSettings,
+    warm: Option<&'w [f64]>,
+    /// The model's value at the start when `coarse`, else `−∞`.
+    reference: f64,
+    coarse: bool,
+    c_norm: f64,
+    h_norm: f64,
+    /// `Hz + c + Eᵀy + Gᵀλ`.
+    r_dual: Vec<f64>,
+    /// `E z`.
+    r_eq: Vec<f64>,
+    /// `G z + s − h`.
+    r_rows: Vec<f64>,
+    /// `λ/s`.
+    d: Vec<f64>,
+}
+
+impl NewtonSystem for QpSystem<'_, '_> {
+    type Error = KktError;
+
+    fn pair_blocks(&self) -> Vec<usize> {
+        vec![self.rows.len()]
+    }
+
+    /// `z = 0` with each set's bounds at its extremes: the step-free
+    /// point, feasible but for the slacks, which are raised to at least
+    /// [`IpmSettings::first_slack`]; `λ` warm (at least
+    /// [`IpmSettings::warm_floor`]) or cold.
+    fn start(&mut self) -> Result<Point, KktError> {
+        let model = self.model;
+        let mut z = vec![0.0; model.n()];
+        let at = model.at_bounds();
+        for (g, set) in model.sets.iter().enumerate() {
+            let s = set.iter().map(|&(_, s)| s);
+            z[at + 2 * g] = s.clone().fold(f64::NEG_INFINITY, f64::max);
+            z[at + 2 * g + 1] = s.fold(f64::INFINITY, f64::min);
         }
-        let decrease = reference - f;
-        let closed = gap <= TOLERANCE * f.abs().max(1.0) || gap <= COARSE * decrease;
-        let residual = primal.max(dual);
-        let stalled = iteration >= STALL_ITERATIONS
-            && residual > 0.5 * residuals[iteration - STALL_ITERATIONS];
-        residuals.push(residual);
-        if closed && (residual <= FEASIBILITY || (stalled && residual <= REDUCED_FEASIBILITY)) {
-            return Ok((z, lambda));
+        if self.coarse {
+            self.reference = model.value(&z);
         }
-        let mu = gap / n_rows as f64;
-
-        let weights = rows.weights(&s, &lambda);
-        kkt.factorize(&weights)?;
-        let d: Vec<f64> = s.iter().zip(&lambda).map(|(s, l)| l / s).collect();
-        // The Newton direction for the complementarity target `r_c`
-        // (`s∘λ` minus what it should become).
-        let mut direction = |r_c: &[f64], refinement: usize| {
-            // δλ = (−r_c + λ∘(r_rows + G δz))/s; the system in (δz, δy):
-            // (H + GᵀDG) δz + Eᵀδy = −r_dual − Gᵀ((−r_c + λ∘r_rows)/s),
-            // E δz = −r_eq.
-            let shifted: Vec<f64> = (0..n_rows)
-                .map(|i| (-r_c[i] + lambda[i] * r_rows[i]) / s[i])
-                .collect();
-            let mut bz: Vec<f64> = r_dual.iter().map(|v| -v).collect();
-            let mut gts = vec![0.0; n];
-            rows.add_transpose_mul(&shifted, &mut gts);
-            bz.iter_mut().zip(&gts).for_each(|(b, g)| *b -= g);
-            let by: Vec<f64> = r_eq.iter().map(|v| -v).collect();
-            let (dz, dy) = refined_solve(model, &rows, &d, &mut kkt, &bz, &by, refinement)?;
-            let gdz = rows.mul(&dz);
-            let ds: Vec<f64> = (0..n_rows).map(|i| -r_rows[i] - gdz[i]).collect();
-            let dl: Vec<f64> = (0..n_rows)
-                .map(|i| (-r_c[i] - lambda[i] * ds[i]) / s[i])
-                .collect();
-            Ok::<_, KktError>((dz, dy, ds, dl))
-        };
-
-        // Predictor.
-        let r_c: Vec<f64> = s.iter().zip(&lambda).map(|(s, l)| s * l).collect();
-        let (_, _, ds, dl) = direction(&r_c, PREDICTOR_REFINEMENT)?;
-        let alpha = step_to_boundary(&s, &ds).min(step_to_boundary(&lambda, &dl));
-        let gap_affine: f64 = (0..n_rows)
-            .map(|i| (s[i] + alpha * ds[i]) * (lambda[i] + alpha * dl[i]))
-            .sum();
-        let sigma = (gap_affine / gap).powi(3).clamp(0.0, 1.0);
-
-        // Corrector.
-        let r_c: Vec<f64> = (0..n_rows)
-            .map(|i| s[i] * lambda[i] + ds[i] * dl[i] - sigma * mu)
+        let gz = self.rows.mul(&z);
+        let first_slack = self.settings.first_slack;
+        let s: Vec<f64> = self
+            .rows
+            .h
+            .iter()
+            .zip(&gz)
+            .map(|(h, g)| (h - g).max(first_slack))
             .collect();
-        let (dz, dy, ds, dl) = direction(&r_c, REFINEMENT_STEPS)?;
-        let alpha = (STEP_FRACTION * step_to_boundary(&s, &ds).min(step_to_boundary(&lambda, &dl)))
-            .min(1.0);
-        for (v, d) in z.iter_mut().zip(&dz) {
-            *v += alpha * d;
+        let n_rows = self.rows.len();
+        let lambda = match self.warm {
+            Some(w) if w.len() == n_rows => {
+                w.iter().map(|&l| l.max(self.settings.warm_floor)).collect()
+            }
+            _ => self.rows.cold_multipliers(),
+        };
+        Ok(Point {
+            primal: s,
+            dual: lambda,
+            free_primal: z,
+            free_dual: vec![0.0; 3 * model.n_free],
+        })
+    }
+
+    fn residuals(&mut self, point: &Point) -> Measures {
+        let model = self.model;
+        let (s, lambda, z, y) = (
+            &point.primal,
+            &point.dual,
+            &point.free_primal,
+            &point.free_dual,
+        );
+        self.r_dual = model.gradient(z);
+        model.equilibrium_transpose_mul(y, &mut self.r_dual);
+        self.rows.add_transpose_mul(lambda, &mut self.r_dual);
+        model.equilibrium_mul(z, &mut self.r_eq);
+        let gz = self.rows.mul(z);
+        for (i, r) in self.r_rows.iter_mut().enumerate() {
+            *r = gz[i] + s[i] - self.rows.h[i];
         }
-        for (v, d) in y.iter_mut().zip(&dy) {
-            *v += alpha * d;
-        }
-        for (v, d) in s.iter_mut().zip(&ds) {
-            *v += alpha * d;
-        }
-        for (v, d) in lambda.iter_mut().zip(&dl) {
-            *v += alpha * d;
+        let gap: f64 = s.iter().zip(lambda).map(|(s, l)| s * l).sum();
+        let f = model.value(z);
+        let decrease = self.reference - f;
+        let coarse = self.settings.coarse_gap / self.settings.gap_tolerance;
+        Measures {
+            primal: norm_inf(&self.r_eq).max(norm_inf(&self.r_rows)) / self.h_norm,
+            dual: norm_inf(&self.r_dual) / self.c_norm,
+            gap: gap / f.abs().max(1.0).max(coarse * decrease),
         }
     }
-    Err(ProgramError::MaxIterations {
-        iterations: MAX_ITERATIONS,
-    })
+
+    fn factor(&mut self, point: &Point) -> Result<(), KktError> {
+        let weights = self.rows.weights(&point.primal, &point.dual);
+        self.kkt.factorize(&weights)?;
+        self.d = point
+            .primal
+            .iter()
+            .zip(&point.dual)
+            .map(|(s, l)| l / s)
+            .collect();
+        Ok(())
+    }
+
+    /// `δλ = (r − λ∘(r_rows + G δz))/s`, `r` the complementarity rows
+    /// (`λ δs + s δλ = r`); the system in `(δz, δy)`:
+    /// `(H + GᵀDG) δz + Eᵀδy = −r_dual − Gᵀ((r + λ∘r_rows)/s)`,
+    /// `E δz = −r_eq`.
+    fn direction(
+        &mut self,
+        point: &Point,
+        complementarity: &[f64],
+        rhs: Rhs,
+    ) -> Result<Point, KktError> {
+        let (s, lambda) = (&point.primal, &point.dual);
+        let n_rows = self.rows.len();
+        let zero = |v: &[f64]| vec![0.0; v.len()];
+        let (r_dual, r_eq, r_rows) = if rhs == Rhs::Centrality {
+            (zero(&self.r_dual), zero(&self.r_eq), zero(&self.r_rows))
+        } else {
+            (self.r_dual.clone(), self.r_eq.clone(), self.r_rows.clone())
+        };
+        let r = complementarity;
+        let shifted: Vec<f64> = (0..n_rows)
+            .map(|i| (r[i] + lambda[i] * r_rows[i]) / s[i])
+            .collect();
+        let mut bz: Vec<f64> = r_dual.iter().map(|v| -v).collect();
+        let mut gts = vec![0.0; bz.len()];
+        self.rows.add_transpose_mul(&shifted, &mut gts);
+        bz.iter_mut().zip(&gts).for_each(|(b, g)| *b -= g);
+        let by: Vec<f64> = r_eq.iter().map(|v| -v).collect();
+        let refinement = if rhs == Rhs::Predictor {
+            self.settings.predictor_refinement_steps
+        } else {
+            self.settings.refinement_steps
+        };
+        let (dz, dy) = refined_solve(
+            self.model,
+            &self.rows,
+            &self.d,
+            &mut self.kkt,
+            &bz,
+            &by,
+            refinement,
+            self.settings.refinement_tolerance,
+        )?;
+        let gdz = self.rows.mul(&dz);
+        let ds: Vec<f64> = (0..n_rows).map(|i| -r_rows[i] - gdz[i]).collect();
+        let dl: Vec<f64> = (0..n_rows)
+            .map(|i| (r[i] - lambda[i] * ds[i]) / s[i])
+            .collect();
+        Ok(Point {
+            primal: ds,
+            dual: dl,
+            free_primal: dz,
+            free_dual: dy,
+        })
+    }
 }
 
 /// Adds to `model` the curvature its linearised `δ ln T_k = p_k + …` leaves
@@ -241,17 +303,9 @@ pub(super) fn add_log_curvature(model: &mut StepModel, lambda: &[f64]) {
     }
 }
 
-/// The largest `α ≤ 1/STEP_FRACTION` with `v + α dv ≥ 0`.
-fn step_to_boundary(v: &[f64], dv: &[f64]) -> f64 {
-    v.iter()
-        .zip(dv)
-        .filter(|(_, &d)| d < 0.0)
-        .map(|(&v, &d)| -v / d)
-        .fold(1.0 / STEP_FRACTION, f64::min)
-}
-
 /// Solves `[H + GᵀDG, Eᵀ; E, 0] (δz, δy) = (bz, by)` with the factor, refined
 /// against the exact operator while the residual keeps halving.
+#[allow(clippy::too_many_arguments)]
 fn refined_solve(
     model: &StepModel,
     rows: &Rows,
@@ -260,6 +314,7 @@ fn refined_solve(
     bz: &[f64],
     by: &[f64],
     max_steps: usize,
+    tolerance: f64,
 ) -> Result<(Vec<f64>, Vec<f64>), KktError> {
     let (mut dz, mut dy) = kkt.solve(bz, by)?;
     // Each block's residual relative to the size of its own terms (a
@@ -282,7 +337,7 @@ fn refined_solve(
         let z_size = bz_norm.max(norm_inf(&kz)).max(f64::MIN_POSITIVE);
         let y_size = by_norm.max(e_norm * norm_inf(&dz)).max(f64::MIN_POSITIVE);
         let norm = (norm_inf(&rz) / z_size).max(norm_inf(&ry) / y_size);
-        if norm <= REFINED || norm > 0.5 * previous {
+        if norm <= tolerance || norm > 0.5 * previous {
             break;
         }
         previous = norm;

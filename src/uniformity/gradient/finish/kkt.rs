@@ -31,9 +31,9 @@
 //!
 //! Near the optimum `h_k` of a cable whose rows are all inactive tends to
 //! zero, and eliminating `p_k` through it would amplify rounding by
-//! `1/h_k`: the factored system keeps `h_k ≥` [`P_FLOOR`] (in `d_k`), and
-//! carries a small static shift on `(ξ, y)`; `ipm.rs` refines each solve
-//! against the exact operator.
+//! `1/h_k`: the factored system keeps `h_k ≥` the settings' `primal_floor`
+//! (in `d_k`), and carries a small static shift (`regularization`) on
+//! `(ξ, y)`; `ipm.rs` refines each solve against the exact operator.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
@@ -45,14 +45,10 @@ use nalgebra::{DMatrix, DVector};
 use super::model::StepModel;
 use crate::fdm::NONE;
 use crate::uniformity::block_pattern::{BlockPattern, PatternError};
+use crate::uniformity::ipm::IpmSettings;
 
 /// Unknowns per free node in the reduced system: `ξ` (3), then `y` (3).
 const B: usize = 6;
-/// The static shift of the scaled reduced matrix (`+` on `ξ`, `−` on `y`).
-const STATIC_SHIFT: f64 = 1e-10;
-/// The least diagonal of `p` in the factored system (a primal
-/// regularisation, refined away).
-const P_FLOOR: f64 = 1e-8;
 /// One thread: a solve with one right-hand side is memory-bound (see the
 /// plan LP's `normal.rs`).
 const PAR: Par = Par::Seq;
@@ -93,6 +89,9 @@ pub(super) enum KktError {
 /// factorisation (once per program), values and factor (per iteration).
 pub(super) struct Kkt<'a> {
     model: &'a StepModel,
+    /// The static shift (`+` on `ξ`, `−` on `y`), the pivots' dynamic
+    /// regularisation and the floor of `h_k`.
+    settings: IpmSettings,
     /// Per cable with two free ends: the place of its upper end among the
     /// lower end's neighbours.
     neighbour: Vec<usize>,
@@ -121,7 +120,7 @@ pub(super) struct Kkt<'a> {
 
 impl<'a> Kkt<'a> {
     /// The pattern and symbolic factorisation of `model`'s reduced system.
-    pub(super) fn new(model: &'a StepModel) -> Result<Self, KktError> {
+    pub(super) fn new(model: &'a StepModel, settings: &IpmSettings) -> Result<Self, KktError> {
         let n_free = model.n_free;
         let n_rows = B * n_free;
         let ends: Vec<[usize; 2]> = model.cables.iter().map(|c| c.ends).collect();
@@ -139,6 +138,7 @@ impl<'a> Kkt<'a> {
         let m = model.m();
         Ok(Kkt {
             model,
+            settings: *settings,
             neighbour,
             values: vec![0.0; col_ptr[n_rows]],
             col_ptr,
@@ -176,9 +176,10 @@ impl<'a> Kkt<'a> {
             }
         }
         // h_k = D_k + rest_k, the rest the box's weight and the curvature,
-        // raised to keep h_k at least P_FLOOR.
+        // raised to keep h_k at least the floor.
+        let floor = self.settings.primal_floor;
         let rest: Vec<f64> = (0..m)
-            .map(|k| (d.boxes[k] + model.cables[k].curvature).max(P_FLOOR - self.ratio[k]))
+            .map(|k| (d.boxes[k] + model.cables[k].curvature).max(floor - self.ratio[k]))
             .collect();
         for ((h, ratio), rest) in self.h.iter_mut().zip(&self.ratio).zip(&rest) {
             *h = ratio + rest;
@@ -354,7 +355,7 @@ impl<'a> Kkt<'a> {
             for p in col_ptr[j]..col_ptr[j + 1] {
                 values[p] *= sj * self.scale[row_idx[p]];
             }
-            values[col_ptr[j]] += STATIC_SHIFT * f64::from(self.signs[j]);
+            values[col_ptr[j]] += self.settings.regularization * f64::from(self.signs[j]);
         }
         if values.iter().any(|v| !v.is_finite()) {
             return Err(KktError::NotFinite);
@@ -366,8 +367,8 @@ impl<'a> Kkt<'a> {
                 Side::Lower,
                 LdltRegularization {
                     dynamic_regularization_signs: Some(&self.signs),
-                    dynamic_regularization_delta: 1e-8,
-                    dynamic_regularization_epsilon: 1e-13,
+                    dynamic_regularization_delta: self.settings.pivot_delta,
+                    dynamic_regularization_epsilon: self.settings.pivot_epsilon,
                 },
                 PAR,
                 MemStack::new(&mut self.buffer),

@@ -45,8 +45,9 @@
 //! linearised problem lowers `J_exact` further, a stationarity certificate of
 //! the nonsmooth problem that does not depend on the net's size.
 //!
-//! The program is solved by an interior point on its structure (`ipm.rs`,
-//! with the Newton systems reduced to the node graph in `kkt.rs`): 7–11
+//! The program is solved by the crate's interior point (`uniformity/ipm`)
+//! on its structure (`ipm.rs`, with the Newton systems reduced to the node
+//! graph in `kkt.rs`, settings [`IpmSettings::finish`]): 7–11
 //! iterations of one sparse LDLᵀ of `6 n_free` unknowns each cold, 5–7 warm
 //! from the previous step's multipliers — 7–13× faster than clarabel on the
 //! program stated generically. clarabel remains the fallback, and the
@@ -66,6 +67,7 @@ use super::objective::{pretension_level, Objective};
 use super::settings::FinishSettings;
 use crate::fdm::{Equilibrium, NONE};
 use crate::status::Termination;
+use crate::uniformity::ipm::IpmSettings;
 use crate::uniformity::{SurfaceTarget, UniformityError};
 use ipm::ProgramError;
 use model::{Cable, ClarabelFailed, ErrorRow, StepModel};
@@ -82,22 +84,27 @@ struct ProgramFailed {
 
 /// The step's optimum `z` at a feasible point (see
 /// [`StepModel::feasible_point`]): the structured interior point
-/// (`ipm.rs`), warm from the previous step's `multipliers` and leaving its
-/// own there; clarabel where it fails (said in `warnings`).
+/// (`ipm.rs`) with `program`, warm from the previous step's `multipliers`
+/// and leaving its own there, its iterations added to `iterations`;
+/// clarabel where it fails (said in `warnings`).
 ///
 /// # Errors
 /// Both failed: each one's reason.
+#[allow(clippy::too_many_arguments)]
 fn solve(
     model: &StepModel,
     eq: &Equilibrium,
+    program: &IpmSettings,
     multipliers: &mut Option<Vec<f64>>,
+    iterations: &mut usize,
     step: usize,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<f64>, ProgramFailed> {
-    let z = match ipm::solve(model, multipliers.as_deref(), true) {
-        Ok((z, lambda)) => {
-            *multipliers = Some(lambda);
-            z
+    let z = match ipm::solve(model, multipliers.as_deref(), true, program) {
+        Ok(solved) => {
+            *multipliers = Some(solved.lambda);
+            *iterations += solved.iterations;
+            solved.z
         }
         Err(interior) => match model.solve_with_clarabel() {
             Ok(z) => {
@@ -121,17 +128,21 @@ pub(super) struct Finished {
     pub(super) objective: f64,
     /// Quadratic programs solved.
     pub(super) steps: usize,
+    /// Interior-point iterations of those programs (clarabel's not counted).
+    pub(super) interior_iterations: usize,
     pub(super) termination: Termination,
     pub(super) warnings: Vec<String>,
 }
 
 /// Sequential QP steps on `J_exact` from `q0` with the trust region and the
 /// stopping test of `settings` (see the module documentation; checked by
-/// [`FinishSettings::validate`] with the solver's settings).
+/// [`FinishSettings::validate`] with the solver's settings), each program
+/// solved with `program` ([`IpmSettings::finish`]).
 pub(super) fn finish(
     objective: &Objective,
     q0: &[f64],
     settings: &FinishSettings,
+    program: &IpmSettings,
 ) -> Result<Finished, UniformityError> {
     let exact = objective.exact();
     let mut q = q0.to_vec();
@@ -140,6 +151,7 @@ pub(super) fn finish(
     let mut warnings = Vec::new();
     let mut steps = 0;
     let mut multipliers = None;
+    let mut interior_iterations = 0;
     let termination = loop {
         if steps == settings.max_steps {
             warnings.push(format!(
@@ -153,7 +165,15 @@ pub(super) fn finish(
         if let Some(lambda) = multipliers.as_deref() {
             ipm::add_log_curvature(&mut model, lambda);
         }
-        let z = match solve(&model, &eq, &mut multipliers, steps, &mut warnings) {
+        let z = match solve(
+            &model,
+            &eq,
+            program,
+            &mut multipliers,
+            &mut interior_iterations,
+            steps,
+            &mut warnings,
+        ) {
             Ok(z) => z,
             Err(failed) => {
                 warnings.push(format!(
@@ -197,6 +217,7 @@ pub(super) fn finish(
         q,
         objective: j,
         steps,
+        interior_iterations,
         termination,
         warnings,
     })

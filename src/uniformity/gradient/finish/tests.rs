@@ -37,7 +37,11 @@ fn the_interior_point_and_clarabel_agree_on_the_step_programs() {
                 let (model, eq) =
                     step_model(&objective, &q, radius, &FinishSettings::default()).expect("model");
                 let feasible = |z: &[f64]| model.feasible_point(z, |rhs| eq.solve_d(rhs));
-                let ours = feasible(&ipm::solve(&model, None, false).expect("interior point").0);
+                let ours = feasible(
+                    &ipm::solve(&model, None, false, &IpmSettings::finish())
+                        .expect("interior point")
+                        .z,
+                );
                 let theirs = feasible(&model.solve_with_clarabel().expect("clarabel"));
                 let (a, b) = (model.value(&ours), model.value(&theirs));
                 let case = format!("{name}, κ {level_weight}, radius {radius}");
@@ -89,7 +93,7 @@ fn the_finish_stops_at_its_step_budget_and_converges_within_the_default() {
         max_steps: 1,
         ..FinishSettings::default()
     };
-    let short = finish(&objective, &q, &one).expect("finish");
+    let short = finish(&objective, &q, &one, &IpmSettings::finish()).expect("finish");
     assert_eq!(short.termination, Termination::MaxIterations);
     assert_eq!(short.steps, 1);
     assert!(
@@ -100,7 +104,13 @@ fn the_finish_stops_at_its_step_budget_and_converges_within_the_default() {
         "{:?}",
         short.warnings
     );
-    let full = finish(&objective, &q, &FinishSettings::default()).expect("finish");
+    let full = finish(
+        &objective,
+        &q,
+        &FinishSettings::default(),
+        &IpmSettings::finish(),
+    )
+    .expect("finish");
     assert_eq!(
         full.termination,
         Termination::Converged,
