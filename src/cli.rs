@@ -244,7 +244,8 @@ pub enum Command {
     /// The design front: ratio against actual surface RMS, sweeping each solver's
     /// accuracy knob (ε for bisection, weight for gradient, λ for least squares).
     ///
-    /// Writes front.csv (solver,knob,ratio,rms_mm,time_s), front.png and front.svg.
+    /// Writes front.csv (solver,knob,ratio,rms_mm,time_s), front.png and front.svg,
+    /// and front-time.png/.svg: every solver's wall time against its surface RMS.
     ///
     /// Example: ringmesh front problems/small-hex.toml --solvers bisection,least-squares --points 8
     Front {

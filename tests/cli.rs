@@ -389,6 +389,20 @@ fn front_writes_csv_and_plots() {
     let svg = std::fs::read_to_string(out.join("front.svg")).unwrap();
     assert!(svg.contains("<svg") && svg.contains("bisection"));
     assert!(!svg.contains("total surface RMS"));
+    // The strategies' cost: the same points, wall time against RMS (a
+    // logarithmic axis: every point's time positive).
+    let time = std::fs::read_to_string(out.join("front-time.svg")).unwrap();
+    assert!(time.contains("bisection") && time.contains("wall time of the design (s)"));
+    let times: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(times.iter().all(|&t| t > 0.0), "times {times:?}");
+    assert_eq!(
+        &std::fs::read(out.join("front-time.png")).unwrap()[..4],
+        b"\x89PNG"
+    );
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
         .filter(|e| {

@@ -26,7 +26,7 @@ pub use output_set::{check_manifest, FileRecord, OutputSet, RunRecord, WithRun};
 pub use pending::abandon_all_and_exit;
 pub use plot::{
     aperture_plot, budget_plot, convergence_plot, front_plot, path_plot, sizing_plot,
-    strategies_plot, strategy_series, study_plot, surface_plot, total_rms_mm, FrontRms,
+    strategies_plot, strategy_series, study_plot, surface_plot, total_rms_mm, FrontRms, FrontY,
     PanelContent, PanelRms, PathFigure, RmsAxis, StrategySeries, StudyRms, SurfaceFigure,
     SurfacePanel,
 };

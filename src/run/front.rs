@@ -7,7 +7,7 @@ use super::{default_output_dir, read_scene, write_shard, Progress, Summary};
 use crate::design::scene_problem;
 use crate::report::{
     front_csv, front_plot, front_row, json_name, readable, write_atomic, FrontRms, FrontRow,
-    OutputSet, RmsAxis, FRONT_COLUMNS,
+    FrontY, OutputSet, RmsAxis, FRONT_COLUMNS,
 };
 use crate::resources::{check_memory, check_scene, SceneCommand};
 use crate::scene::Scene;
@@ -230,9 +230,15 @@ fn front_problem(scene: &Scene, rms: RmsAxis) -> Result<(UniformityProblem, Fron
 const BYTES_PER_POINT: u64 = 512;
 
 /// The files of a whole front.
-pub(crate) const FILES: [&str; 3] = ["front.csv", "front.png", "front.svg"];
+pub(crate) const FILES: [&str; 5] = [
+    "front.csv",
+    "front.png",
+    "front.svg",
+    "front-time.png",
+    "front-time.svg",
+];
 
-/// `front.csv` (the table `csv`), `front.png`, `front.svg` (drawn from `rows`
+/// `front.csv` (the table `csv`), `front.png`, `front.svg`, `front-time.png`, `front-time.svg` (drawn from `rows`
 /// against `rms`, the `failed` points — solver, knob — listed when known),
 /// written into `set` (begun with [`FILES`]) and swapped in.
 pub(crate) fn write_front(
@@ -247,10 +253,20 @@ pub(crate) fn write_front(
     front_plot(
         rows,
         failed,
-        rms,
+        (rms, FrontY::Ratio),
         &title,
         &set.path("front.png"),
         &set.path("front.svg"),
+    )?;
+    // The strategies' cost: every solver's accuracy against its time.
+    let title = format!("{scene}: what each solver's surface accuracy costs in time");
+    front_plot(
+        rows,
+        failed,
+        (rms, FrontY::Time),
+        &title,
+        &set.path("front-time.png"),
+        &set.path("front-time.svg"),
     )?;
     write_atomic(&set.path("front.csv"), csv.as_bytes())?;
     set.seal()?;

@@ -1,10 +1,11 @@
 //! The design front: `Tmax/Tmin` against the surface RMS of a forward
 //! solve, or the total with the net's facet RMS, one curve per solver, each
-//! point labelled with its knob.
+//! point labelled with its knob — and the same points with their wall time
+//! for `Tmax/Tmin` ([`FrontY::Time`]): what each strategy's accuracy costs
+//! in time, every solver on one axis pair.
 
 use std::path::Path;
 
-use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::canvas::{png_and_svg, titled_with_legend};
@@ -49,30 +50,55 @@ impl FrontRms {
     }
 }
 
+/// What a front figure's vertical axis shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrontY {
+    /// `Tmax/Tmin` (linear): the design front.
+    Ratio,
+    /// The point's wall time, s (logarithmic): the strategies' cost.
+    Time,
+}
+
+impl FrontY {
+    /// The value `row` is drawn at.
+    fn of(self, row: &FrontRow) -> f64 {
+        match self {
+            FrontY::Ratio => row.ratio,
+            FrontY::Time => row.time_s,
+        }
+    }
+}
+
 pub(super) fn draw_front<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     points: &[FrontRow],
     failed: Option<&[(String, f64)]>,
-    rms: &FrontRms,
+    (rms, y_axis): (&FrontRms, FrontY),
     title: &str,
 ) -> Result<(), DrawError>
 where
     DB::ErrorType: 'static,
 {
-    let ok: Vec<&FrontRow> = points.iter().filter(|p| p.ratio.is_finite()).collect();
+    let ok: Vec<&FrontRow> = points
+        .iter()
+        .filter(|p| p.ratio.is_finite() && (y_axis == FrontY::Ratio || p.time_s > 0.0))
+        .collect();
     let (plot, legend) = titled_with_legend(&root, title, 72)?;
     let x = |p: &FrontRow| rms.of(p).max(RMS_FLOOR_MM);
     let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
     for p in &ok {
         x_lo = x_lo.min(x(p));
         x_hi = x_hi.max(x(p));
-        y_lo = y_lo.min(p.ratio);
-        y_hi = y_hi.max(p.ratio);
+        y_lo = y_lo.min(y_axis.of(p));
+        y_hi = y_hi.max(y_axis.of(p));
     }
     if ok.is_empty() {
         (x_lo, x_hi, y_lo, y_hi) = (RMS_FLOOR_MM, 1.0, 1.0, 2.0);
     }
-    let (y_lo, y_hi) = ((y_lo * 0.95).max(1.0 - 1e-9), y_hi * 1.05 + 1e-9);
+    let (y_lo, y_hi) = match y_axis {
+        FrontY::Ratio => ((y_lo * 0.95).max(1.0 - 1e-9), y_hi * 1.05 + 1e-9),
+        FrontY::Time => (y_lo / 2.0, (y_hi * 2.0).max(y_lo * 10.0)),
+    };
     let mut solvers: Vec<&str> = Vec::new();
     let failures = failed.unwrap_or_default();
     for p in ok
@@ -93,32 +119,40 @@ where
         .x_label_area_size(45)
         .y_label_area_size(60);
     // The design's RMS spans decades: a logarithmic axis. The total, led by
-    // the facets, rarely spans one: a linear axis fitted to it.
-    match rms {
-        FrontRms::Design => {
-            let x_range = (x_lo / 2.0)..(x_hi * 4.0).max(x_lo * 10.0);
-            let mut chart = builder.build_cartesian_2d(x_range.log_scale(), y_lo..y_hi)?;
-            chart
-                .configure_mesh()
-                .x_desc(rms.caption())
-                .x_label_formatter(&|v| format!("{v:.0e}"))
-                .y_desc("Tmax / Tmin")
-                .label_style(("sans-serif", 14))
-                .draw()?;
-            draw_front_points(&mut chart, &ok, &solvers, &colour, rms)?;
-        }
+    // the facets, rarely spans one: a linear axis fitted to it. Times span
+    // decades too.
+    let x_range = match rms {
+        FrontRms::Design => (x_lo / 2.0)..(x_hi * 4.0).max(x_lo * 10.0),
         FrontRms::Total { .. } => {
             let span = (x_hi - x_lo).max(0.05 * x_hi);
-            let x_range = (x_lo - 0.15 * span)..(x_hi + 0.25 * span);
-            let mut chart = builder.build_cartesian_2d(x_range, y_lo..y_hi)?;
-            chart
-                .configure_mesh()
-                .x_desc(rms.caption())
-                .x_label_formatter(&|v| readable(*v, 4))
-                .y_desc("Tmax / Tmin")
-                .label_style(("sans-serif", 14))
-                .draw()?;
-            draw_front_points(&mut chart, &ok, &solvers, &colour, rms)?;
+            (x_lo - 0.15 * span)..(x_hi + 0.25 * span)
+        }
+    };
+    let x_log = matches!(rms, FrontRms::Design);
+    let points = FrontPoints {
+        ok: &ok,
+        solvers: &solvers,
+        colour: &colour,
+        rms,
+        y_axis,
+    };
+    match (x_log, y_axis) {
+        (true, FrontY::Ratio) => {
+            let chart = builder.build_cartesian_2d(x_range.log_scale(), y_lo..y_hi)?;
+            points.draw(chart, true)?;
+        }
+        (true, FrontY::Time) => {
+            let chart =
+                builder.build_cartesian_2d(x_range.log_scale(), (y_lo..y_hi).log_scale())?;
+            points.draw(chart, true)?;
+        }
+        (false, FrontY::Ratio) => {
+            let chart = builder.build_cartesian_2d(x_range, y_lo..y_hi)?;
+            points.draw(chart, false)?;
+        }
+        (false, FrontY::Time) => {
+            let chart = builder.build_cartesian_2d(x_range, (y_lo..y_hi).log_scale())?;
+            points.draw(chart, false)?;
         }
     }
     // The legend below the plot: the solvers, the floor, the failures.
@@ -164,59 +198,99 @@ where
     Ok(root.present()?)
 }
 
-/// The front's points on `chart` (x: the RMS `rms` draws them at, floored
-/// at [`RMS_FLOOR_MM`]): one line per solver, each point labelled with its
-/// knob where the label has room.
-fn draw_front_points<DB, X>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<X, RangedCoordf64>>,
-    ok: &[&FrontRow],
-    solvers: &[&str],
-    colour: &dyn Fn(&str) -> RGBAColor,
-    rms: &FrontRms,
-) -> Result<(), DrawError>
-where
-    DB: DrawingBackend,
-    DB::ErrorType: 'static,
-    X: Ranged<ValueType = f64>,
-{
-    let x = |p: &FrontRow| rms.of(p).max(RMS_FLOOR_MM);
-    let mut anchors = Vec::new();
-    for solver in solvers {
-        let c = colour(solver);
-        let mut series: Vec<&FrontRow> =
-            ok.iter().copied().filter(|p| p.solver == *solver).collect();
-        series.sort_by(|a, b| x(a).total_cmp(&x(b)));
-        chart.draw_series(LineSeries::new(
-            series.iter().map(|p| (x(p), p.ratio)),
-            c.stroke_width(2),
-        ))?;
-        // A point below the axis floor is drawn at it, hollow.
-        chart.draw_series(series.iter().map(|p| {
-            let style = if rms.of(p) < RMS_FLOOR_MM {
-                c.stroke_width(2)
-            } else {
-                c.filled()
-            };
-            Circle::new((x(p), p.ratio), 4, style)
-        }))?;
-        anchors.extend(series.iter().map(|p| ((x(p), p.ratio), knob_label(p.knob))));
-    }
-    // Each point labelled with its knob, where the label has room.
-    let pixels: Vec<((i32, i32), Option<&str>)> = anchors
-        .iter()
-        .map(|(p, label)| (chart.backend_coord(p), Some(label.as_str())))
-        .collect();
-    let offsets = place_labels(&pixels);
-    chart.draw_series(
-        anchors
+/// The front's points to draw: those with a value, their solvers and
+/// colours, and the axes they are drawn against.
+struct FrontPoints<'a> {
+    ok: &'a [&'a FrontRow],
+    solvers: &'a [&'a str],
+    colour: &'a dyn Fn(&str) -> RGBAColor,
+    rms: &'a FrontRms,
+    y_axis: FrontY,
+}
+
+impl FrontPoints<'_> {
+    /// The mesh of `chart` (x logarithmic when `x_log`) and the points on
+    /// it (x: the RMS `rms` draws them at, floored at [`RMS_FLOOR_MM`]):
+    /// one line per solver, each point labelled with its knob where the
+    /// label has room.
+    fn draw<DB, X, Y>(
+        &self,
+        mut chart: ChartContext<'_, DB, Cartesian2d<X, Y>>,
+        x_log: bool,
+    ) -> Result<(), DrawError>
+    where
+        DB: DrawingBackend,
+        DB::ErrorType: 'static,
+        X: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>,
+    {
+        let (rms, y_axis) = (self.rms, self.y_axis);
+        let x_format = |v: &f64| match x_log {
+            true => format!("{v:.0e}"),
+            false => readable(*v, 4),
+        };
+        let y_format = |v: &f64| match y_axis {
+            FrontY::Ratio => readable(*v, 4),
+            FrontY::Time => readable(*v, 2),
+        };
+        chart
+            .configure_mesh()
+            .x_desc(rms.caption())
+            .x_label_formatter(&x_format)
+            .y_desc(match y_axis {
+                FrontY::Ratio => "Tmax / Tmin",
+                FrontY::Time => "wall time of the design (s)",
+            })
+            .y_label_formatter(&y_format)
+            .label_style(("sans-serif", 14))
+            .draw()?;
+        let x = |p: &FrontRow| rms.of(p).max(RMS_FLOOR_MM);
+        let mut anchors = Vec::new();
+        for solver in self.solvers {
+            let c = (self.colour)(solver);
+            let mut series: Vec<&FrontRow> = self
+                .ok
+                .iter()
+                .copied()
+                .filter(|p| p.solver == *solver)
+                .collect();
+            series.sort_by(|a, b| x(a).total_cmp(&x(b)));
+            chart.draw_series(LineSeries::new(
+                series.iter().map(|p| (x(p), y_axis.of(p))),
+                c.stroke_width(2),
+            ))?;
+            // A point below the axis floor is drawn at it, hollow.
+            chart.draw_series(series.iter().map(|p| {
+                let style = if rms.of(p) < RMS_FLOOR_MM {
+                    c.stroke_width(2)
+                } else {
+                    c.filled()
+                };
+                Circle::new((x(p), y_axis.of(p)), 4, style)
+            }))?;
+            anchors.extend(
+                series
+                    .iter()
+                    .map(|p| ((x(p), y_axis.of(p)), knob_label(p.knob))),
+            );
+        }
+        // Each point labelled with its knob, where the label has room.
+        let pixels: Vec<((i32, i32), Option<&str>)> = anchors
             .iter()
-            .zip(offsets)
-            .filter_map(|((p, label), offset)| {
-                let offset = offset?;
-                Some(EmptyElement::at(*p) + Text::new(label.clone(), offset, label_font()))
-            }),
-    )?;
-    Ok(())
+            .map(|(p, label)| (chart.backend_coord(p), Some(label.as_str())))
+            .collect();
+        let offsets = place_labels(&pixels);
+        chart.draw_series(
+            anchors
+                .iter()
+                .zip(offsets)
+                .filter_map(|((p, label), offset)| {
+                    let offset = offset?;
+                    Some(EmptyElement::at(*p) + Text::new(label.clone(), offset, label_font()))
+                }),
+        )?;
+        Ok(())
+    }
 }
 
 /// Draws the design front (ratio against actual surface RMS — the forward
@@ -228,7 +302,7 @@ where
 pub fn front_plot(
     points: &[FrontRow],
     failed: Option<&[(String, f64)]>,
-    rms: &FrontRms,
+    axes: (&FrontRms, FrontY),
     title: &str,
     png: &Path,
     svg: &Path,
@@ -240,7 +314,7 @@ pub fn front_plot(
         svg,
         points,
         failed,
-        rms,
+        axes,
         title
     )
 }

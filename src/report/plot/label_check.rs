@@ -18,7 +18,7 @@ use plotters_backend::{BackendColor, BackendCoord, BackendTextStyle, DrawingErro
 
 use super::accuracy_vs_time::StudyRms;
 use super::surface_error::{PanelContent, PanelRms, SurfaceFigure, SurfacePanel};
-use super::FrontRms;
+use super::{FrontRms, FrontY};
 use crate::report::{parse_front_row, parse_study_row, DrawError, FrontRow};
 use crate::scene::{Scene, TrussModel};
 use crate::sizing::{SectionTrial, TubeSection};
@@ -236,16 +236,18 @@ fn front_labels_never_overlap() {
             .iter()
             .map(|l| parse_front_row(l).unwrap())
             .collect();
-        let boxes = text_boxes((1000, 680), |area| {
-            super::front::draw_front(
-                area,
-                &rows,
-                Some(&[]),
-                &FrontRms::Design,
-                "paper-26m: design front (Tmax/Tmin against surface RMS)",
-            )
-        });
-        assert_apart(&path.display().to_string(), &boxes);
+        for y_axis in [FrontY::Ratio, FrontY::Time] {
+            let boxes = text_boxes((1000, 680), |area| {
+                super::front::draw_front(
+                    area,
+                    &rows,
+                    Some(&[]),
+                    (&FrontRms::Design, y_axis),
+                    "paper-26m: design front (Tmax/Tmin against surface RMS)",
+                )
+            });
+            assert_apart(&format!("{} ({y_axis:?})", path.display()), &boxes);
+        }
     }
 }
 

@@ -24,7 +24,7 @@ pub use aperture::aperture_plot;
 pub use budget::budget_plot;
 pub use convergence::convergence_plot;
 pub use frame_path::{path_plot, PathFigure};
-pub use front::{front_plot, FrontRms};
+pub use front::{front_plot, FrontRms, FrontY};
 pub use sizing::sizing_plot;
 pub use strategies::{strategies_plot, strategy_series, StrategySeries};
 pub use surface_error::{surface_plot, PanelContent, PanelRms, SurfaceFigure, SurfacePanel};
