@@ -125,7 +125,7 @@ pub(crate) struct System {
     /// The structure of the sparse inertia count, analysed at its first
     /// use ([`super::stability::negative_eigenvalues`]); `None` inside when
     /// it could not be.
-    pub(crate) inertia: std::sync::OnceLock<Option<super::stability::InertiaStructure>>,
+    pub(crate) inertia: std::sync::OnceLock<Option<super::inertia::InertiaStructure>>,
 }
 
 /// The symbolic factorisation of a sparse tangent.

@@ -43,6 +43,7 @@ mod condensed;
 mod corrector;
 mod critical;
 mod follower;
+mod inertia;
 mod joint;
 mod limit;
 mod load_control;
