@@ -124,7 +124,7 @@ where
     Ok(())
 }
 
-fn draw_budget<DB: DrawingBackend>(
+pub(super) fn draw_budget<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     table: &BudgetTable,
     samples: &[(f64, f64)],

@@ -19,6 +19,7 @@ use plotters_backend::{BackendColor, BackendCoord, BackendTextStyle, DrawingErro
 use super::accuracy_vs_time::StudyRms;
 use super::surface_error::{PanelContent, PanelRms, SurfaceFigure, SurfacePanel};
 use super::{FrontRms, FrontY};
+use crate::budget::{BudgetRow, BudgetTable, PointKind};
 use crate::report::{parse_front_row, parse_study_row, DrawError, FrontRow};
 use crate::scene::{Scene, TrussModel};
 use crate::sizing::{SectionTrial, TubeSection};
@@ -496,6 +497,48 @@ fn surface_error_labels_never_overlap() {
         };
         let boxes = text_boxes(super::surface_error::figure_size(&figure), |area| {
             super::surface_error::draw_surface(area, &figure)
+        });
+        assert_apart(&path.display().to_string(), &boxes);
+    }
+}
+
+#[test]
+fn budget_labels_never_overlap() {
+    // Every committed budget (`results/<scene>/budget*/`), drawn from its
+    // points' table as `budget` and `merge` draw it.
+    let mut found: Vec<PathBuf> = std::fs::read_dir(results())
+        .unwrap()
+        .flat_map(|scene| {
+            std::fs::read_dir(scene.unwrap().path())
+                .into_iter()
+                .flatten()
+        })
+        .map(|e| e.unwrap().path().join("budget-samples.csv"))
+        .filter(|p| p.is_file())
+        .collect();
+    found.sort();
+    assert!(!found.is_empty(), "no committed budget");
+    for path in found {
+        let rows: Vec<BudgetRow> = table(&path)
+            .iter()
+            .map(|l| BudgetRow::parse(l).unwrap())
+            .collect();
+        let table = BudgetTable::of(&rows, Some(8.0));
+        let samples: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.kind == PointKind::Sample)
+            .filter_map(|r| {
+                let linear = r.linear.as_ref()?.as_ref().ok()?;
+                Some((r.nonlinear.as_ref().ok()?.best_fit_mm, linear.best_fit_mm))
+            })
+            .collect();
+        let boxes = text_boxes((1600, 700), |area| {
+            super::budget::draw_budget(
+                area,
+                &table,
+                &samples,
+                "super-60m: error budget of the conventional design as built on the flexible truss",
+            )
         });
         assert_apart(&path.display().to_string(), &boxes);
     }
