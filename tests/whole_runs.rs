@@ -185,11 +185,17 @@ fn an_interrupted_run_removes_its_staging_folder() {
 }
 
 /// Two runs into one folder at once: one writes its complete set, the other
-/// is refused before computing (exit 2) and says why.
+/// is refused before computing (exit 2) and says why — into a folder that
+/// exists, and into one that neither finds (both create it: the refused one
+/// once removed it, empty, from under the other, whose set was then lost).
 #[test]
 fn of_two_runs_into_one_folder_one_writes_and_the_other_says_why_not() {
-    let (_root, scene, out) = scratch();
-    for _ in 0..3 {
+    let (_root, scene, existing) = scratch();
+    for k in 0..8 {
+        let out = match k % 2 {
+            0 => existing.clone(),
+            _ => existing.with_file_name(format!("fresh-{k}")),
+        };
         let a = spawn_design(&scene, &out);
         let b = spawn_design(&scene, &out);
         let outputs: Vec<Output> = [a, b]
@@ -212,7 +218,7 @@ fn of_two_runs_into_one_folder_one_writes_and_the_other_says_why_not() {
         );
         eprintln!("run {id} wrote; the other: {}", why.trim());
     }
-    assert!(staging_beside(&out).is_empty());
+    assert!(staging_beside(&existing).is_empty());
 }
 
 /// Out of space while writing (a 32 KiB file size limit, `ulimit -f 64` in

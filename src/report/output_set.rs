@@ -147,10 +147,21 @@ impl OutputSet {
             check_name(name)?;
         }
         check_writable(dir).map_err(unwritable_at(dir))?;
-        let created = fs::symlink_metadata(dir).is_err();
-        fs::create_dir_all(dir).map_err(unwritable_at(dir))?;
+        // Created by this run only if this run's `mkdir` made it: two runs
+        // starting together both find it missing, and one of them creates it.
+        if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+            fs::create_dir_all(parent).map_err(unwritable_at(dir))?;
+        }
+        let created = match fs::create_dir(dir) {
+            Ok(()) => true,
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => false,
+            Err(e) => return Err(unwritable_at(dir)(e)),
+        };
         let prepared = Self::prepare_created(dir, names, beside, created);
-        if prepared.is_err() && created {
+        // A refusal leaves no folder it made — except when another run
+        // holds it (`Busy`): that run writes into it, and stages beside it
+        // until then, so it is empty and still that run's target.
+        if matches!(prepared, Err(ref e) if !matches!(e, ReportError::Busy { .. })) && created {
             let _ = fs::remove_dir(dir);
         }
         prepared
