@@ -1091,7 +1091,11 @@ mod tests {
                     let set = OutputSet::begin(&sub, &["s.csv"]).unwrap();
                     fs::write(set.path("s.csv"), format!("inner {i}")).unwrap();
                     let written = set.commit().unwrap();
-                    // What the run reports written is there.
+                    // What the run reports written is there — for a reader
+                    // that takes `X`'s lock, as every ringmesh writer does:
+                    // a swap of `X` moves `X/sub` into the new `X` under it,
+                    // so an unlocked read can fall in between.
+                    let _reading = lock_folder(&dir, Hold::Shared, Wait::Yes).unwrap();
                     assert_eq!(
                         fs::read_to_string(&written[0]).unwrap(),
                         format!("inner {i}")
