@@ -210,6 +210,13 @@ pub(super) fn negative_eigenvalues(
     }
 }
 
+/// The tangent's values at `state` (pattern order), `None` when one is not
+/// finite: what both counts factor.
+fn finite_tangent(solver: &StaticSolver, state: &State, lambda: f64) -> Option<Vec<f64>> {
+    let ev = solver.system().evaluate(solver.model(), state, lambda);
+    ev.values.iter().all(|v| v.is_finite()).then_some(ev.values)
+}
+
 /// [`negative_eigenvalues`] by faer's dense Bunch–Kaufman `LBLᵀ` of the
 /// whole tangent, whatever its size.
 pub(super) fn dense_negative_eigenvalues(
@@ -218,11 +225,7 @@ pub(super) fn dense_negative_eigenvalues(
     lambda: f64,
 ) -> Option<usize> {
     let system = solver.system();
-    let ev = system.evaluate(solver.model(), state, lambda);
-    if ev.values.iter().any(|v| !v.is_finite()) {
-        return None;
-    }
-    let j = system.dense_tangent(&ev.values);
+    let j = system.dense_tangent(&finite_tangent(solver, state, lambda)?);
     let n = system.n_rows;
     let mut largest: f64 = 0.0;
     let mut asymmetry: f64 = 0.0;
@@ -251,11 +254,9 @@ pub(super) fn sparse_negative_eigenvalues(
     lambda: f64,
 ) -> Option<usize> {
     let system = solver.system();
-    let ev = system.evaluate(solver.model(), state, lambda);
-    if ev.values.iter().any(|v| !v.is_finite()) {
-        return None;
-    }
-    let j = system.sparse_tangent(&ev.values).ok()?;
+    let j = system
+        .sparse_tangent(&finite_tangent(solver, state, lambda)?)
+        .ok()?;
     let structure = system
         .inertia
         .get_or_init(|| InertiaStructure::new(&j, system.n_free, system.scale).ok())
