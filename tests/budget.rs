@@ -27,7 +27,7 @@ fn core<'a>(scene: &'a Scene, run: &'a DesignRun) -> PerturbedAssembly<'a> {
         &run.mesh,
         &run.network,
         &run.report.net,
-        run.truss_equilibrium.as_ref(),
+        run.assembled.clone(),
     )
     .expect("the design assembles")
 }

@@ -414,3 +414,47 @@ fn a_design_carries_the_mean_tensions_its_scene_asks_for() {
         }
     }
 }
+
+/// The design run assembles its conventional comparison on the flexible
+/// design's analysis of the assembly (issue 38): the same equilibrium as the
+/// conventional design assembled on its own, with the same slack cables.
+#[test]
+fn the_conventional_comparison_on_the_designs_analysis_is_its_own_assembly() {
+    let scene = common::scene("small-hex");
+    let run =
+        ringmesh::design::run(&scene, &DesignSettings::default(), &mut |_, _| {}).expect("designs");
+    let shared = run.report.conventional.as_ref().expect("the truss deforms");
+    let (network, _) = run.conventional_assembly.as_ref().expect("assembled");
+    let conventional = run.conventional_net.as_ref().expect("designed");
+    let own = verify(
+        &scene,
+        &run.mesh,
+        &SceneEffects::of(&scene),
+        network,
+        conventional,
+        AssemblyTruss::Flexible,
+        None,
+    )
+    .expect("assembles on its own");
+    let relative = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+    assert!(
+        relative(shared.rms_mm, own.rms_mm) < 1e-6,
+        "{} against {}",
+        shared.rms_mm,
+        own.rms_mm
+    );
+    assert_eq!(shared.slack_cables, own.slack_cables);
+    let worst = shared
+        .tensions_n
+        .iter()
+        .zip(&own.tensions_n)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let scale = own.tensions_n.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+    assert!(
+        worst <= 1e-9 * scale,
+        "tensions differ by {worst} N of {scale} N"
+    );
+    // And it is the comparison that matters: far from the flexible design.
+    assert!(shared.rms_mm > 100.0 * run.report.verification.rms_mm);
+}

@@ -776,3 +776,36 @@ fn an_unsupported_rod_is_refused_as_a_mechanism() {
         other => panic!("expected a mechanism, got {:?}", other.map(|s| s.frames[3])),
     }
 }
+
+/// A solver of a model of the same structure shares the analysis
+/// (`StaticSolver::with_model`) and finds what a fresh solver finds; a model
+/// of another structure is refused, naming it.
+#[test]
+fn a_model_of_the_same_structure_shares_the_analysis_and_another_is_refused() {
+    let revolute = JointKind::Revolute { axis: Vector3::x() };
+    let first = shaft(revolute, shaft_force(), shaft_moment());
+    let second = shaft(revolute, -2.0 * shaft_force(), shaft_moment());
+    let shared = first
+        .solver
+        .with_model(second.solver.model().clone())
+        .expect("the same structure");
+    let settings = StaticSettings::default();
+    let a = shared.solve(&settings).unwrap();
+    let b = second.solver.solve(&settings).unwrap();
+    assert!(a.converged() && b.converged());
+    for (fa, fb) in a.state.frames.iter().zip(&b.state.frames) {
+        assert!((fa.position_m - fb.position_m).norm() <= 1e-12);
+    }
+    // The loaded body is where the two loads differ: it moved.
+    let moved = (a.state.frames[second.body].position_m
+        - first.solver.solve(&settings).unwrap().state.frames[first.body].position_m)
+        .norm();
+    assert!(moved > 1e-3, "{moved}");
+    let other = shaft(JointKind::Fixed, shaft_force(), shaft_moment());
+    let refused = first.solver.with_model(other.solver.model().clone());
+    assert!(
+        matches!(&refused, Err(e) if e.to_string().contains("another structure")),
+        "{:?}",
+        refused.err()
+    );
+}

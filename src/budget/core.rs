@@ -11,9 +11,11 @@ use crate::geometry::ReflectorMesh;
 use crate::network::Network;
 use crate::scene::Scene;
 use crate::surface::{best_fit_nodes, node_rms};
-use crate::truss::{RingTruss, RingTrussBuilder, TrussEquilibrium};
+use crate::truss::{RingTruss, RingTrussBuilder};
 use crate::uniformity::Design;
-use crate::verify::{assemble, Assembled, AssemblyInputs, Linearised, Perturbation, Verification};
+use crate::verify::{
+    assemble, Assembled, AssemblyInputs, AssemblyStart, Linearised, Perturbation, Verification,
+};
 
 /// A design assembled on the scene's exact truss, ready to be perturbed.
 pub struct PerturbedAssembly<'a> {
@@ -55,9 +57,9 @@ pub struct Measured {
 }
 
 impl<'a> PerturbedAssembly<'a> {
-    /// Assemble `design` (made on `network` of `mesh`) on the exact truss of
-    /// `scene`, from `start` (the truss's equilibrium under the design's
-    /// pull, when known).
+    /// `design` (made on `network` of `mesh`) assembled on the exact truss
+    /// of `scene`: `nominal` where the caller has it (the design run's,
+    /// [`crate::design::DesignRun::assembled`]), otherwise assembled here.
     ///
     /// # Errors
     /// A truss or assembly that fails.
@@ -66,7 +68,7 @@ impl<'a> PerturbedAssembly<'a> {
         mesh: &'a ReflectorMesh,
         network: &'a Network,
         design: &'a Design,
-        start: Option<&TrussEquilibrium>,
+        nominal: Option<Assembled>,
     ) -> Result<Self, BudgetError> {
         let effects = SceneEffects::of(scene);
         let frame = RingTruss::builder(scene, &mesh.truss, &effects);
@@ -78,7 +80,10 @@ impl<'a> PerturbedAssembly<'a> {
             design,
             frame: Some(&frame),
         };
-        let nominal = assemble(&inputs, start, &Perturbation::none())?;
+        let nominal = match nominal {
+            Some(nominal) => nominal,
+            None => assemble(&inputs, AssemblyStart::Unknown, &Perturbation::none())?,
+        };
         let fixed = network.fixed_mask();
         let free_front: Vec<usize> = (0..mesh.n_front_nodes).filter(|&i| !fixed[i]).collect();
         let nominal_front_m = free_front
@@ -154,7 +159,11 @@ impl<'a> PerturbedAssembly<'a> {
     /// # Errors
     /// No equilibrium, or a perturbation the assembly cannot take.
     pub fn newton(&self, perturbation: &Perturbation) -> Result<Verification, BudgetError> {
-        let a = assemble(&self.inputs(), Some(&self.nominal.state), perturbation)?;
+        let a = assemble(
+            &self.inputs(),
+            AssemblyStart::Assembly(&self.nominal),
+            perturbation,
+        )?;
         Ok(a.verification)
     }
 

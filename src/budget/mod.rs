@@ -208,30 +208,34 @@ pub fn run(
         });
     }
     let mut timings = BudgetTimings::default();
+    let conventional_network;
     let clock = Instant::now();
-    let run = design::run(scene, design, &mut |_, _| {})?;
+    let mut run = design::run(scene, design, &mut |_, _| {})?;
     timings.design_s = clock.elapsed().as_secs_f64();
     let scene = &resolve(scene)?;
-    let (network, net, start) = match settings.design {
-        BudgetDesign::Flexible => (
-            &run.network,
-            &run.report.net,
-            run.truss_equilibrium.as_ref(),
-        ),
-        BudgetDesign::Conventional => match (&run.conventional_start, &run.conventional_net) {
-            (Some((network, start)), Some(net)) => (network, net, start.as_ref()),
-            _ => {
-                return Err(BudgetError::Scene {
-                    key: "effects.truss",
-                    reason: "rigid: the design is made for the undeformed truss already, \
+    // The design run's own assembly is the nominal one (on a rigid-truss
+    // scene it has none on the exact truss, and the core assembles it).
+    let (network, net, nominal) = match settings.design {
+        BudgetDesign::Flexible => (&run.network, &run.report.net, run.assembled.take()),
+        BudgetDesign::Conventional => {
+            match (run.conventional_assembly.take(), &run.conventional_net) {
+                (Some((network, assembled)), Some(net)) => {
+                    conventional_network = network;
+                    (&conventional_network, net, Some(assembled))
+                }
+                _ => {
+                    return Err(BudgetError::Scene {
+                        key: "effects.truss",
+                        reason: "rigid: the design is made for the undeformed truss already, \
                              there is no conventional design to compare"
-                        .into(),
-                })
+                            .into(),
+                    })
+                }
             }
-        },
+        }
     };
     let clock = Instant::now();
-    let core = PerturbedAssembly::new(scene, &run.mesh, network, net, start)?;
+    let core = PerturbedAssembly::new(scene, &run.mesh, network, net, nominal)?;
     timings.assembly_s = clock.elapsed().as_secs_f64();
     let clock = Instant::now();
     let tangent = core.linearise()?;

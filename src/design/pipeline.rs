@@ -22,9 +22,11 @@ use crate::network::Network;
 use crate::scene::{Scene, TrussModel};
 use crate::status::Termination;
 use crate::surface::{budget, resolve_front_rings, FrontSurface, SurfaceBudget};
-use crate::truss::{RingTruss, RingTrussBuilder, TrussEquilibrium, TrussError};
+use crate::truss::{RingTruss, RingTrussBuilder, TrussError};
 use crate::uniformity::{Design, SolverKind, UniformitySet};
-use crate::verify::{verify_on_frame, Verification};
+use crate::verify::{
+    assemble, Assembled, AssemblyInputs, AssemblyStart, Perturbation, Verification,
+};
 
 /// Choices of a design run: plain data with defaults.
 #[derive(Debug, Clone)]
@@ -221,13 +223,13 @@ pub struct DesignRun {
     pub conventional_net: Option<Design>,
     /// The uniformity sets the design makes uniform (cables of `network`).
     pub sets: Vec<UniformitySet>,
-    /// The flexible truss's equilibrium under the design's pull (the loop's
-    /// last; absent for a rigid truss): what an assembly of the design
-    /// starts from.
-    pub truss_equilibrium: Option<TrussEquilibrium>,
-    /// The conventional design's network and its truss equilibrium (the
-    /// loop's iteration 0), when the truss deforms.
-    pub conventional_start: Option<(Network, Option<TrussEquilibrium>)>,
+    /// The design assembled on the flexible truss (`report.verification`'s
+    /// equilibrium), when the truss deforms: what a perturbed assembly of
+    /// it starts from ([`crate::budget`]).
+    pub assembled: Option<Assembled>,
+    /// The conventional design's network and its assembly on the same truss
+    /// (`report.conventional`'s), when the truss deforms.
+    pub conventional_assembly: Option<(Network, Assembled)>,
 }
 
 /// The outer design loop (net design ⇄ truss response) of `scene` with each
@@ -353,15 +355,20 @@ pub fn run_observed(
     let stage = Instant::now();
     let network = outcome.problem.network().clone();
     let sets = outcome.problem.sets().to_vec();
-    let verification = verify_on_frame(
+    let inputs = AssemblyInputs {
         scene,
         mesh,
         effects,
-        &network,
-        &outcome.design,
+        network: &network,
+        design: &outcome.design,
         frame,
-        outcome.truss_equilibrium.as_ref(),
-    )?;
+    };
+    let start = outcome
+        .truss_equilibrium
+        .as_ref()
+        .map_or(AssemblyStart::Unknown, AssemblyStart::Truss);
+    let assembled = assemble(&inputs, start, &Perturbation::none())?;
+    let verification = assembled.verification.clone();
     timings.verification_s = stage.elapsed().as_secs_f64();
     observer.stage(DesignStage::Surface);
     let stage = Instant::now();
@@ -388,26 +395,38 @@ pub fn run_observed(
     let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
     // undeformed attachment points, assembled from the truss's response to
-    // it that the loop already solved.
-    let conventional_net = frame.map(|_| outcome.initial.design.clone());
-    let conventional_start = frame.map(|_| {
-        (
-            outcome.initial.problem.network().clone(),
-            outcome.initial_truss_equilibrium.clone(),
-        )
-    });
-    let conventional = match frame {
+    // it that the loop already solved, on the design's analysis of the
+    // assembly (the same network and truss, other cut lengths).
+    let conventional_assembly = match frame {
         None => None,
-        Some(frame) => Some(verify_on_frame(
-            scene,
-            mesh,
-            effects,
-            outcome.initial.problem.network(),
-            &outcome.initial.design,
-            Some(frame),
-            outcome.initial_truss_equilibrium.as_ref(),
-        )?),
+        Some(frame) => {
+            let network = outcome.initial.problem.network();
+            let inputs = AssemblyInputs {
+                scene,
+                mesh,
+                effects,
+                network,
+                design: &outcome.initial.design,
+                frame: Some(frame),
+            };
+            let start = match &outcome.initial_truss_equilibrium {
+                Some(truss) => AssemblyStart::Beside {
+                    truss,
+                    beside: &assembled,
+                },
+                None => AssemblyStart::Unknown,
+            };
+            let conventional = assemble(&inputs, start, &Perturbation::none())?;
+            Some((network.clone(), conventional))
+        }
     };
+    let conventional = conventional_assembly
+        .as_ref()
+        .map(|(_, a)| a.verification.clone());
+    let conventional_net = conventional_assembly
+        .as_ref()
+        .map(|_| outcome.initial.design.clone());
+    let assembled = frame.map(|_| assembled);
     timings.conventional_s = stage.elapsed().as_secs_f64();
     let report = DesignReport {
         scene: scene.name.clone(),
@@ -436,8 +455,8 @@ pub fn run_observed(
         network,
         conventional_net,
         sets,
-        truss_equilibrium: outcome.truss_equilibrium,
-        conventional_start,
+        assembled,
+        conventional_assembly,
     })
 }
 

@@ -58,7 +58,6 @@ mod sparse_lu;
 mod stability;
 mod statics;
 
-pub(crate) use assembly::constraint_scale;
 pub use assembly::State;
 pub use beam::{ElementKind, Section};
 pub use cable::{Cable, CableState};

@@ -138,7 +138,7 @@ impl Linearisation<'_> {
     /// # Errors
     /// A model of another structure, or a non-finite response.
     pub fn respond(&self, changed: &Model) -> Result<State, MechanicsError> {
-        self.check_structure(changed)?;
+        self.solver.check_structure(changed)?;
         let system = self.solver.system();
         let ev = system.evaluate(changed, &self.state, self.lambda);
         let change: Vec<f64> = ev
@@ -184,7 +184,7 @@ impl Linearisation<'_> {
         settings: &StaticSettings,
     ) -> Result<Option<(State, usize)>, MechanicsError> {
         settings.validate()?;
-        self.check_structure(changed)?;
+        self.solver.check_structure(changed)?;
         let system = self.solver.system();
         let weights = self.solver.weights();
         let step = |factor: &Factor, residual: &[f64]| {
@@ -229,23 +229,6 @@ impl Linearisation<'_> {
             previous = size;
         }
         Ok(None)
-    }
-
-    /// Refuses a model of another structure than the linearised one.
-    fn check_structure(&self, changed: &Model) -> Result<(), MechanicsError> {
-        let model = self.solver.model();
-        if changed.node_count() != model.node_count()
-            || changed.elements.len() != model.elements.len()
-            || changed.cables.len() != model.cables.len()
-            || changed.joints.len() != model.joints.len()
-            || changed.fixed != model.fixed
-        {
-            return Err(MechanicsError::invalid(
-                "linearised response",
-                "the changed model has another structure than the linearised one",
-            ));
-        }
-        Ok(())
     }
 }
 

@@ -14,7 +14,7 @@ use super::response::{
     check_loads, layout_points, TrussEquilibrium, TrussError, TrussOracle, TrussResponse,
 };
 use crate::geometry::RingTrussLayout;
-use crate::mechanics::{constraint_scale, NodalLoad, NodeId, State, StaticSettings, StaticSolver};
+use crate::mechanics::{NodalLoad, NodeId, State, StaticSettings, StaticSolver};
 
 /// The first load step of a solve from the unloaded truss, as a fraction of
 /// the loads. Load control tells a step that jumps past a limit point by the
@@ -147,7 +147,7 @@ impl TrussOracle for ExactTruss {
     fn equilibrium(&self) -> Option<TrussEquilibrium> {
         self.previous.clone().map(|state| TrussEquilibrium {
             state,
-            constraint_scale: constraint_scale(self.solver.model()),
+            constraint_scale: self.solver.constraint_scale(),
         })
     }
 }

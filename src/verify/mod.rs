@@ -32,7 +32,6 @@ use serde::Serialize;
 use crate::algebra::norm3;
 use crate::effects::SceneEffects;
 use crate::geometry::{ReflectorMesh, RingTrussLayout};
-use crate::mechanics::constraint_scale;
 use crate::mechanics::{
     Frame, Linearisation, Model, ModelBuilder, NodeId, StaticSettings, StaticSolver,
 };
@@ -175,7 +174,8 @@ pub fn verify_on_frame(
         design,
         frame,
     };
-    Ok(assemble(&inputs, equilibrium, &Perturbation::none())?.verification)
+    let start = equilibrium.map_or(AssemblyStart::Unknown, AssemblyStart::Truss);
+    Ok(assemble(&inputs, start, &Perturbation::none())?.verification)
 }
 
 /// What an assembly is made of: the scene, its mesh and effects, the design
@@ -201,6 +201,7 @@ pub struct AssemblyInputs<'a> {
 /// An assembled equilibrium: its verification, and what a perturbed
 /// assembly starts from ([`assemble`] with `start`) or is linearised about
 /// ([`Assembled::linearise`]).
+#[derive(Clone)]
 pub struct Assembled {
     /// The assembly judged against the design.
     pub verification: Verification,
@@ -218,7 +219,7 @@ struct AssemblyModels {
     /// Truss and points only.
     bare: ModelBuilder,
     /// Every cable: its model nodes, EA, the distance of its ends in
-    /// `bare`, its design cut length and its (perturbed) cut length.
+    /// `bare` and its (perturbed) cut length.
     cables: Vec<CableItem>,
     /// Model node of each net node.
     node_of: Vec<NodeId>,
@@ -229,7 +230,6 @@ struct CableItem {
     nodes: [NodeId; 2],
     ea_n: f64,
     start_m: f64,
-    designed_m: f64,
     cut_m: f64,
 }
 
@@ -345,7 +345,6 @@ impl AssemblyModels {
                     nodes,
                     ea_n: ea * factor(&perturbation.cable_stiffness_factors),
                     start_m,
-                    designed_m,
                     cut_m: designed_m * factor(&perturbation.cable_length_factors),
                 }
             })
@@ -360,29 +359,29 @@ impl AssemblyModels {
     /// The truss and points with every cable's unstressed length ramped
     /// between `ends(cable)` ([`crate::mechanics::Cable`]'s load factors 0
     /// and 1).
-    fn with_cables(&self, ends: impl Fn(&CableItem) -> [f64; 2]) -> ModelBuilder {
+    fn with_cables(&self, ends: impl Fn(usize, &CableItem) -> [f64; 2]) -> ModelBuilder {
         let mut b = self.bare.clone();
-        for c in &self.cables {
-            b.add_cable(c.nodes[0], c.nodes[1], c.ea_n, ends(c));
+        for (k, c) in self.cables.iter().enumerate() {
+            b.add_cable(c.nodes[0], c.nodes[1], c.ea_n, ends(k, c));
         }
         b
     }
 
     /// Truss, points and cables at their cut lengths.
     fn cut(&self) -> ModelBuilder {
-        self.with_cables(|c| [c.cut_m, c.cut_m])
+        self.with_cables(|_, c| [c.cut_m, c.cut_m])
     }
 
     /// The same with the cables' unstressed lengths ramped from the
     /// stress-free distance of their ends.
     fn ramped(&self) -> ModelBuilder {
-        self.with_cables(|c| [c.start_m, c.cut_m])
+        self.with_cables(|_, c| [c.start_m, c.cut_m])
     }
 
-    /// The same with the cables ramped from the design's cut lengths to the
-    /// perturbed ones (a warm start's path).
-    fn ramped_from_design(&self) -> ModelBuilder {
-        self.with_cables(|c| [c.designed_m, c.cut_m])
+    /// The same with the cables ramped from `from_m` (network order), the
+    /// cut lengths at which a warm start is an equilibrium, to their own.
+    fn ramped_from(&self, from_m: &[f64]) -> ModelBuilder {
+        self.with_cables(|k, c| [from_m[k], c.cut_m])
     }
 }
 
@@ -406,23 +405,53 @@ const PERTURBED_MAX_STEPS: usize = 40;
 /// tangent ([`Linearised::solve`]) before Newton takes over.
 const CHORD_ITERATIONS: usize = 20;
 
-/// Assemble `inputs`' design, as built with `perturbation`, and solve.
+/// Where an assembly's Newton starts ([`assemble`]).
+#[derive(Clone, Copy)]
+pub enum AssemblyStart<'a> {
+    /// Nothing known: the flexible truss's equilibrium under the design's
+    /// pull is solved here (a rigid truss has none to solve).
+    Unknown,
+    /// The flexible truss's equilibrium under the design's pull (the design
+    /// loop's last, see [`verify`]).
+    Truss(&'a TrussEquilibrium),
+    /// The same design's assembled equilibrium, for the design perturbed:
+    /// its state starts Newton, its structure's analysis is shared
+    /// ([`StaticSolver::with_model`]), and where Newton does not converge
+    /// at once the cut lengths are ramped from its own.
+    Assembly(&'a Assembled),
+    /// Another design on the same network and truss (the conventional one
+    /// beside the flexible): Newton starts from `truss`, this design's own
+    /// truss equilibrium, as from [`AssemblyStart::Truss`], and `beside`'s
+    /// analysis is shared. (On super-60m the flexible design's assembled
+    /// state was the worse start for the conventional one: 4 + 19 Newton
+    /// iterations against 4 + 7 from its own truss equilibrium.)
+    Beside {
+        /// This design's truss equilibrium.
+        truss: &'a TrussEquilibrium,
+        /// The other design's assembly.
+        beside: &'a Assembled,
+    },
+}
+
+/// Assemble `inputs`' design, as built with `perturbation`, and solve from
+/// `start`.
 ///
-/// `start` is an equilibrium to start Newton from: the flexible truss's
-/// under the design's pull (the design loop's last, see [`verify`]), or a
-/// whole assembly's ([`Assembled::state`], of the same inputs) for the
-/// same assembly perturbed; without it, the truss's is solved here. From an
-/// assembly's state a perturbed one that Newton does not reach at once is
-/// followed from it with the cut lengths ramped from the design's, and
-/// fails if that fails; otherwise the last resort is the ramp from the
-/// undeformed truss.
+/// From a truss equilibrium, Newton takes [`GUESS_ITERATIONS`]; if that
+/// fails, the prestrain is ramped from the undeformed truss in load steps.
+/// From the same design's assembly, Newton takes as many; then the cut
+/// lengths are ramped from the assembly's, in at most
+/// [`PERTURBED_MAX_STEPS`] load steps, and the assembly fails if that
+/// fails (the ramp from the undeformed truss would repeat the design's
+/// whole assembly to find what this path could not, and took minutes for
+/// nothing on small-hex's samples of 2 mm cut-length errors).
 ///
 /// # Errors
 /// As [`verify`]; a perturbation of the wrong size or one the assembly
-/// cannot take (named); inextensible cables with a perturbation.
+/// cannot take (named); inextensible cables with a perturbation; a start
+/// assembly of another structure.
 pub fn assemble(
     inputs: &AssemblyInputs<'_>,
-    start: Option<&TrussEquilibrium>,
+    start: AssemblyStart<'_>,
     perturbation: &Perturbation,
 ) -> Result<Assembled, VerifyError> {
     let AssemblyInputs {
@@ -451,67 +480,83 @@ pub fn assemble(
                 .into(),
         ));
     }
-    let layout = &mesh.truss;
     let models = AssemblyModels::new(inputs, perturbation)?;
     let ea = scene.cables.axial_stiffness_n();
     let settings = assembly_settings();
-    // First from the truss as the design's pull deforms it (the equilibrium
-    // sought is near: Newton from the undeformed truss can diverge, the hinge
-    // motion being many times the cables' elastic stretch); then, if that
-    // fails, from the undeformed truss with the prestrain ramped in load steps.
+    // One Newton solve, no step cuts, a few iterations: from a good guess
+    // it converges at once; otherwise a ramp is the better path.
+    let once = StaticSettings {
+        min_step: settings.initial_step,
+        max_iterations: GUESS_ITERATIONS,
+        ..settings.clone()
+    };
+    // The analysis of the structure: shared with another assembly's where
+    // the start comes with one.
+    let shared = match start {
+        AssemblyStart::Assembly(a) | AssemblyStart::Beside { beside: a, .. } => Some(&a.solver),
+        AssemblyStart::Unknown | AssemblyStart::Truss(_) => None,
+    };
+    let solver_of = |b: ModelBuilder| -> Result<StaticSolver, VerifyError> {
+        let model = b.build()?;
+        Ok(match shared {
+            Some(s) => s.with_model(model)?,
+            None => StaticSolver::new(model)?,
+        })
+    };
     let mut found = None;
-    // A whole assembly's state, or the truss's alone?
-    let whole = start.is_some_and(|e| e.state.frames.len() == models.bare.node_count());
-    let guess = match (frame, start) {
-        (None, Some(e)) if whole => Some(Cow::Borrowed(e)),
-        (None, _) => None,
-        (Some(_), Some(e)) => Some(Cow::Borrowed(e)),
-        (Some(frame), None) => truss_guess(frame, layout, design)?.map(Cow::Owned),
-    };
-    let start_of = |solver: &StaticSolver, guess: &TrussEquilibrium| {
-        let mut start = solver.reference_state();
-        let frames = &guess.state.frames;
-        start.frames[..frames.len()].copy_from_slice(frames);
-        start.set_multipliers(&guess.state);
-        start.rescale_multipliers(guess.constraint_scale / constraint_scale(solver.model()));
-        start
-    };
-    if let Some(guess) = &guess {
-        let solver = StaticSolver::new(models.cut().build()?)?;
-        let start = start_of(&solver, guess);
-        // One Newton solve, no step cuts, a few iterations: from a good
-        // guess it converges at once; otherwise the ramp below is the
-        // better path.
-        let once = StaticSettings {
-            min_step: settings.initial_step,
-            max_iterations: GUESS_ITERATIONS,
-            ..settings.clone()
-        };
-        let s = solver.solve_from(start, 0.0, &once)?;
+    if let AssemblyStart::Assembly(from) = start {
+        let start = &from.state.state;
+        let solver = solver_of(models.cut())?;
+        let s = solver.solve_from(start.clone(), 0.0, &once)?;
         if s.converged() {
             found = Some((solver, s));
-        } else if whole && !perturbation.is_none() {
-            // A perturbed assembly from the design's: its cut lengths
-            // ramped from the design's, in load steps.
-            let solver = StaticSolver::new(models.ramped_from_design().build()?)?;
-            let start = start_of(&solver, guess);
+        } else {
+            let from_m: Vec<f64> = from
+                .solver
+                .model()
+                .cables()
+                .iter()
+                .map(|c| c.rest_length_m(1.0))
+                .collect();
+            let solver = solver_of(models.ramped_from(&from_m))?;
             let ramp = StaticSettings {
                 max_steps: PERTURBED_MAX_STEPS,
                 ..settings.clone()
             };
-            let s = solver.solve_from(start, 0.0, &ramp)?;
-            // At load factor 1 its model is the perturbed assembly's. If it
-            // fails, so does the assembly: the ramp from the undeformed
-            // truss would repeat the design's whole assembly to find what
-            // this path could not (and took minutes for nothing on
-            // small-hex's samples of 2 mm cut-length errors).
+            let s = solver.solve_from(start.clone(), 0.0, &ramp)?;
+            // At load factor 1 its model is the perturbed assembly's.
             found = Some((solver, s));
+        }
+    } else {
+        // First from the truss as the design's pull deforms it (the
+        // equilibrium sought is near: Newton from the undeformed truss can
+        // diverge, the hinge motion being many times the cables' elastic
+        // stretch); then, if that fails, from the undeformed truss with the
+        // prestrain ramped in load steps.
+        let guess = match (frame, start) {
+            (None, _) => None,
+            (Some(_), AssemblyStart::Truss(e) | AssemblyStart::Beside { truss: e, .. }) => {
+                Some(Cow::Borrowed(e))
+            }
+            (Some(frame), _) => truss_guess(frame, &mesh.truss, design)?.map(Cow::Owned),
+        };
+        if let Some(guess) = &guess {
+            let solver = solver_of(models.cut())?;
+            let mut start = solver.reference_state();
+            let frames = &guess.state.frames;
+            start.frames[..frames.len()].copy_from_slice(frames);
+            start.set_multipliers(&guess.state);
+            start.rescale_multipliers(guess.constraint_scale / solver.constraint_scale());
+            let s = solver.solve_from(start, 0.0, &once)?;
+            if s.converged() {
+                found = Some((solver, s));
+            }
         }
     }
     let (solver, solution) = match found {
         Some(found) => found,
         None => {
-            let solver = StaticSolver::new(models.ramped().build()?)?;
+            let solver = solver_of(models.ramped())?;
             let s = solver.solve(&settings)?;
             (solver, s)
         }
@@ -549,7 +594,7 @@ pub fn assemble(
     verification.load_steps = load_steps;
     verification.time_s = clock.elapsed().as_secs_f64();
     let state = TrussEquilibrium {
-        constraint_scale: constraint_scale(solver.model()),
+        constraint_scale: solver.constraint_scale(),
         state: solution.state,
     };
     Ok(Assembled {
@@ -557,6 +602,14 @@ pub fn assemble(
         state,
         solver,
     })
+}
+
+impl std::fmt::Debug for Assembled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Assembled")
+            .field("verification", &self.verification)
+            .finish_non_exhaustive()
+    }
 }
 
 impl Assembled {

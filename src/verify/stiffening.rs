@@ -5,9 +5,7 @@
 
 use super::VerifyError;
 use crate::effects::INEXTENSIBLE_STIFFENING;
-use crate::mechanics::{
-    constraint_scale, ModelBuilder, StaticSettings, StaticSolution, StaticSolver,
-};
+use crate::mechanics::{ModelBuilder, StaticSettings, StaticSolution, StaticSolver};
 
 /// Stiffening of each stage of the continuation from the elastic cables to
 /// the inextensible ones.
@@ -59,8 +57,7 @@ pub(crate) fn stiffen(
         }
         let next = StaticSolver::new(b.build()?)?;
         let mut start = solution.state.clone();
-        start
-            .rescale_multipliers(constraint_scale(solver.model()) / constraint_scale(next.model()));
+        start.rescale_multipliers(solver.constraint_scale() / next.constraint_scale());
         let s = next.solve_from(start, 0.0, settings)?;
         newton_iterations += s.newton_iterations;
         load_steps += s.steps.len();
