@@ -59,7 +59,8 @@ fn perturbations(
     };
     let drawn = match &scene.tolerances {
         Some(t) => {
-            let model = ToleranceModel::new(t, &run.mesh, &run.network, &run.report.net, &scene.cables);
+            let model =
+                ToleranceModel::new(t, &run.mesh, &run.network, &run.report.net, &scene.cables);
             let n = samples.unwrap_or(t.samples.unwrap_or(100));
             (0..n).map(|k| model.sample(1, k)).collect()
         }

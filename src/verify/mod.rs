@@ -401,9 +401,10 @@ fn assembly_settings() -> StaticSettings {
 /// and a budget reports it.
 const PERTURBED_MAX_STEPS: usize = 40;
 
-/// Chord iterations a perturbed assembly is given from its design's
-/// tangent ([`Linearised::solve`]) before Newton takes over.
-const CHORD_ITERATIONS: usize = 20;
+/// Chord (and Newton) iterations a perturbed assembly is given from its
+/// design's tangent ([`Linearised::solve`]) before load steps take over:
+/// super-60m's tolerance samples take 12–14.
+const CHORD_ITERATIONS: usize = 40;
 
 /// Where an assembly's Newton starts ([`assemble`]).
 #[derive(Clone, Copy)]
