@@ -178,11 +178,19 @@ impl IpmSettings {
     /// Its start is [`Start::TensionScaled`]: on the three net families of
     /// issue 38 it saved 1–13 of 21–77 iterations in five of six nets at
     /// 10³/10⁴ free nodes (one more on the regular sector grid at 10⁴).
+    ///
+    /// Its iteration limit is 200: the jittered sector grid of issue 38
+    /// (`tests/common/nets.rs`) takes 33, 42, 64 iterations at 10³, 2.4·10³,
+    /// 10⁴ free nodes and 134 at 10⁵ (converged; the gap still fell by about
+    /// 0.8 per iteration at the default limit of 100, 2·10⁻⁶ there, so the
+    /// run ended in `MaxIterations` and the route fell back to clarabel,
+    /// which needs minutes at that size).
     pub(crate) fn plan() -> Self {
         IpmSettings {
             regularization: 1e-12,
             pivot_epsilon: 1e-30,
             start: Start::TensionScaled,
+            max_iterations: 200,
             ..IpmSettings::default()
         }
     }
