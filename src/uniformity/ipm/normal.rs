@@ -300,8 +300,9 @@ mod tests {
     }
 
     /// The solves with the factor's own supernodal kernel agree with faer's
-    /// supernodal solve to rounding, with `Θ` spanning twelve orders of
-    /// magnitude (as near an optimum).
+    /// supernodal solve to rounding (they differ only in the order of the
+    /// sums; measured 5·10⁻¹⁴ of the solution), with `Θ` spanning twelve
+    /// orders of magnitude (as near an optimum).
     #[test]
     fn own_supernodal_solve_matches_faer() {
         let lp = grid_lp(60);
@@ -339,7 +340,7 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         assert!(
-            difference <= 1e-10 * scale,
+            difference <= 1e-12 * scale,
             "own solve differs by {difference:e} of {scale:e}"
         );
     }
