@@ -297,19 +297,22 @@ impl Dissection<'_> {
             }
             return;
         }
-        // Split into connected components first.
+        // Split into connected components first, all at once.
         self.search(nodes[0], label);
         if self.queue.len() < nodes.len() {
-            let component = self.queue.clone();
             self.clear_levels();
-            let component_label = self.label(&component);
-            let rest: Vec<usize> = nodes
-                .into_iter()
-                .filter(|&v| self.part[v] != component_label)
-                .collect();
-            let size = component.len();
-            stack.push((component, first));
-            stack.push((rest, first + size));
+            let mut at = first;
+            for &v in &nodes {
+                if self.part[v] == label {
+                    self.search(v, label);
+                    let component = self.queue.clone();
+                    self.clear_levels();
+                    self.label(&component);
+                    let size = component.len();
+                    stack.push((component, at));
+                    at += size;
+                }
+            }
             return;
         }
         // A pseudo-peripheral root: restart from a least-degree node of the
@@ -335,6 +338,7 @@ impl Dissection<'_> {
         let depth = self.max_level() + 1;
         if depth < 3 {
             // No level has nodes on both sides: order the part as a leaf.
+            self.leaves.push((first, nodes.len()));
             self.clear_levels();
             self.perm[first..first + nodes.len()].copy_from_slice(&self.queue);
             return;
@@ -513,10 +517,10 @@ mod tests {
                 "{nx}×{ny}"
             );
         }
-        // Two grids side by side and four isolated nodes, no edges between.
+        // Two grids side by side and many isolated nodes, no edges between.
         let (a, b) = (triangulated_grid(20, 20, 7), triangulated_grid(9, 30, 1));
         let (na, nb) = (a.nrows(), b.nrows());
-        let n = na + nb + 4;
+        let n = na + nb + 2000;
         let mut col_ptr = vec![0];
         let mut row_idx = Vec::new();
         for (graph, offset) in [(&a, 0), (&b, na)] {
