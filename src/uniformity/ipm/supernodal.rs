@@ -5,9 +5,11 @@
 //! faer's own supernodal solve calls its general triangular-solve and
 //! matrix-product kernels once per supernode; a net's normal matrix has
 //! tens of thousands of supernodes of a few columns each, where those calls
-//! cost more than the arithmetic. Measured on the plan LPs of issue 38's three
-//! net families at 10⁴ free nodes (19 826 rows, 1.5–1.7·10⁶ values of `L`),
-//! one solve took 1.8–2.8 ms here against 3.4–3.9 ms with faer's.
+//! cost more than the arithmetic. Measured on the same factor, solves
+//! interleaved, best of 18: 1.1 ms against 1.5 ms with faer's at 2·10⁴ rows
+//! (1.5·10⁶ values of `L`), 41–53 ms against 56–68 ms at 2·10⁵ rows; on the
+//! plan LPs of issue 38's three net families at 10⁴ free nodes, 3.6–4.2 ms
+//! against 5.1–6.7 ms a solve on average (the machine shared).
 
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
