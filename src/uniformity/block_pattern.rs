@@ -1,30 +1,27 @@
 //! The pattern of a symmetric matrix on a net's free nodes in `b × b`
 //! blocks — the pattern of the FDM matrix `D = C_fᵀ Q C_f` (eq. 3–4) with
-//! each entry a dense block — with its fill-reducing ordering (AMD on the
-//! node graph, expanded blockwise) and its symbolic Cholesky factorisation.
+//! each entry a dense block — with its fill-reducing ordering (AMD or nested
+//! dissection on the node graph, whichever fills less: `ordering.rs`,
+//! expanded blockwise) and its symbolic Cholesky factorisation.
 //! The interior points of `ipm/` (normal matrix, `b = D`) and of the
 //! gradient's exact finish (reduced Newton system, `b = 6`) share it.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, SymbolicCholesky, SymmetricOrdering,
 };
 use faer::sparse::{FaerError, SymbolicSparseColMat};
 use faer::Side;
 
+use super::ordering::{self, OrderingError};
 use crate::fdm::{d_sparsity, NONE};
 
 /// Why the pattern could not be set up.
 #[derive(Debug, thiserror::Error)]
 pub(crate) enum PatternError {
-    /// A workspace could not be allocated.
-    #[error("out of memory for the AMD ordering")]
-    OutOfMemory,
     /// The fill-reducing ordering of the node graph failed.
-    #[error("AMD ordering: {0:?}")]
-    Ordering(FaerError),
+    #[error(transparent)]
+    Ordering(#[from] OrderingError),
     /// The symbolic Cholesky factorisation failed.
     #[error("symbolic factorisation: {0:?}")]
     Symbolic(FaerError),
@@ -68,18 +65,7 @@ impl BlockPattern {
             .collect();
         let neighbours = |f: usize| &graph_idx[graph_ptr[f] + 1..graph_ptr[f + 1]];
 
-        let mut perm = vec![0usize; n_free];
-        let mut perm_inv = vec![0usize; n_free];
-        let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n_free, graph_idx.len()))
-            .map_err(|_| PatternError::OutOfMemory)?;
-        amd::order(
-            &mut perm,
-            &mut perm_inv,
-            graph.as_ref(),
-            amd::Control::default(),
-            MemStack::new(&mut mem),
-        )
-        .map_err(PatternError::Ordering)?;
+        let ordering::Ordering { perm, perm_inv, .. } = ordering::fill_reducing(graph.as_ref())?;
         let block_perm: Vec<usize> = (0..n_rows).map(|r| b * perm[r / b] + r % b).collect();
         let block_perm_inv: Vec<usize> = (0..n_rows).map(|r| b * perm_inv[r / b] + r % b).collect();
 

@@ -17,6 +17,7 @@ mod gradient;
 mod ipm;
 mod least_squares;
 mod lp;
+mod ordering;
 mod plan;
 mod problem;
 mod selection;

@@ -136,15 +136,15 @@ impl Program {
             let lt = self.lengths[k] * sc.theta[k];
             dlam[j] = (h[j] + lt * (g[k] + atdy[k]) - ds) * sc.g_inv[j];
         }
-        let dx = (0..self.m)
-            .map(|k| {
-                let et = match self.in_set[k] {
-                    NONE => 0.0,
-                    j => self.lengths[k] * dlam[j],
-                };
-                sc.theta[k] * (atdy[k] - et + g[k])
-            })
-            .collect();
+        // Room for `dw` after `dx` (the driver's `primal`): no reallocation.
+        let mut dx = Vec::with_capacity(self.m + self.set.len());
+        dx.extend((0..self.m).map(|k| {
+            let et = match self.in_set[k] {
+                NONE => 0.0,
+                j => self.lengths[k] * dlam[j],
+            };
+            sc.theta[k] * (atdy[k] - et + g[k])
+        }));
         (dx, dlam, dy, ds)
     }
 
@@ -301,9 +301,8 @@ impl Program {
             .map(|j| rhs.rw[j] + rhs.rwl[j] / lam[j])
             .collect();
         let (mut dx, dlam, dy, ds) = self.solve_reduced(normal, sc, &g, &h, rhs.rp, rhs.rs);
-        let mut dz: Vec<f64> = (0..self.m)
-            .map(|k| (rhs.rxz[k] - z[k] * dx[k]) / x[k])
-            .collect();
+        let mut dz = Vec::with_capacity(self.m + self.set.len());
+        dz.extend((0..self.m).map(|k| (rhs.rxz[k] - z[k] * dx[k]) / x[k]));
         let dw = (0..self.set.len()).map(|j| (rhs.rwl[j] - w[j] * dlam[j]) / lam[j]);
         dx.extend(dw);
         dz.extend(dlam);

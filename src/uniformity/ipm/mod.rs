@@ -25,14 +25,16 @@
 //!
 //! `Θ = X Z⁻¹`, `Ω = W Λ⁻¹`, `a = A α` with `α_k = θ_k ℓ_k / G_j`, `γ = Σ 1/G_j`.
 //! The normal matrix `M = A Θ̃ Aᵀ` has the pattern of `D = C_fᵀ Q C_f` with dense
-//! D×D blocks: its pattern, fill-reducing ordering (AMD on the node graph,
-//! expanded blockwise) and symbolic Cholesky factorisation are built once; every
-//! iteration refills the values, scales `M` to unit diagonal, and refactors
-//! numerically. Dependent rows of `A` (mechanisms of the net) show up as
-//! (near-)zero pivots, which faer's dynamic regularisation replaces by a huge
-//! pivot, i.e. the direction is dropped. The border is eliminated with the same
-//! factor (`t = M̂⁻¹ a` once per iteration). This reduction, with the factor
-//! `M̂` in place of `M`, is only a preconditioner: each Newton direction is
+//! D×D blocks: its pattern, fill-reducing ordering (AMD or nested dissection on
+//! the node graph, whichever fills less, expanded blockwise) and symbolic
+//! Cholesky factorisation are built once; every iteration refills the values,
+//! scales `M` to unit diagonal, and refactors numerically; the solves with the
+//! supernodal factor run in `supernodal.rs`'s kernel. Dependent rows of `A`
+//! (mechanisms of the net) show up as (near-)zero pivots, which faer's dynamic
+//! regularisation replaces by a huge pivot, i.e. the direction is dropped. The
+//! border is eliminated with the same factor (`t = M̂⁻¹ a` once per
+//! iteration). This reduction, with the factor `M̂` in place of `M`, is only a
+//! preconditioner: each Newton direction is
 //! completed by FGMRES on the rows of the *unreduced* system it does not solve
 //! exactly (`A dx = r_p`, the `w` rows, `eᵀdλ = r_s`), whose residuals are
 //! formed from moderate quantities. Refining the reduced system instead
@@ -46,8 +48,9 @@
 //! boundary, the centrality correctors, the stopping tests and the status;
 //! the problem owns its variables, start, residuals and linear algebra. The
 //! ratio LP above is one problem (`ratio.rs`, with its data in `data.rs`,
-//! the normal system and its factorisation in `normal.rs`, the Newton
-//! direction with its FGMRES completion in `direction.rs`); the exact
+//! the normal system and its factorisation in `normal.rs`, its solves in
+//! `supernodal.rs`, the Newton direction with its FGMRES completion in
+//! `direction.rs`); the exact
 //! finish's quadratic program is the other (`gradient/finish/ipm.rs`). One
 //! settings struct ([`IpmSettings`], `settings.rs`) serves both, what the LP
 //! returns is `status.rs`'s, and why it could not start is `error.rs`'s
@@ -61,6 +64,7 @@ mod normal;
 mod ratio;
 mod settings;
 mod status;
+mod supernodal;
 mod system;
 
 pub(crate) use data::RatioLp;

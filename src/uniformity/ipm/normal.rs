@@ -1,7 +1,8 @@
 //! The normal system `M = A Θ̃ Aᵀ` of the reduced Newton system: its pattern,
 //! fill-reducing ordering and symbolic Cholesky factorisation (once), its
 //! numeric factorisation per iteration (scaled to unit diagonal, shifted when a
-//! pivot fails), the products with `A` and `Aᵀ`, and solves with iterative
+//! pivot fails), the products with `A` and `Aᵀ`, and solves with the factor
+//! (`supernodal.rs`'s kernel on a supernodal factor) and with iterative
 //! refinement against the exact `M`.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -13,6 +14,7 @@ use faer::{Conj, MatMut, Par, Side};
 use super::data::RatioLp;
 use super::error::NormalError;
 use super::settings::IpmSettings;
+use super::supernodal::Supernodes;
 use crate::algebra::norm_inf;
 use crate::fdm::NONE;
 use crate::uniformity::block_pattern::BlockPattern;
@@ -43,6 +45,10 @@ pub(super) struct NormalMatrix<const D: usize> {
     /// `1/√M_ii`.
     scale: Vec<f64>,
     factor: Vec<f64>,
+    /// The factor's supernodes for the solves of
+    /// [`NormalMatrix::precondition`] (`None` when faer chose a simplicial
+    /// factor, which faer's own solve serves).
+    supernodes: Option<Supernodes>,
     buffer: MemBuffer,
     settings: IpmSettings,
 }
@@ -71,6 +77,7 @@ impl<const D: usize> NormalMatrix<D> {
         let buffer =
             MemBuffer::try_new(req).map_err(|_| NormalError::OutOfMemory("the factorisation"))?;
         let factor = vec![0.0; symbolic.len_val()];
+        let supernodes = Supernodes::of(&symbolic);
         Ok(NormalMatrix {
             n_rows,
             ends,
@@ -82,6 +89,7 @@ impl<const D: usize> NormalMatrix<D> {
             symbolic,
             scale: vec![1.0; n_rows],
             factor,
+            supernodes,
             buffer,
             settings: *settings,
         })
@@ -201,6 +209,10 @@ impl<const D: usize> NormalMatrix<D> {
 
     /// `r ← M̂⁻¹ r` with the current (regularised) factor `M̂`.
     pub(super) fn precondition(&mut self, r: &mut [f64]) {
+        if let Some(supernodes) = &mut self.supernodes {
+            supernodes.solve_scaled(&self.factor, &self.scale, r);
+            return;
+        }
         for (v, s) in r.iter_mut().zip(&self.scale) {
             *v *= s;
         }
@@ -245,5 +257,91 @@ impl<const D: usize> NormalMatrix<D> {
             x.iter_mut().zip(&r).for_each(|(x, r)| *x += r);
         }
         x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The plan LP of an `n × n` triangulated grid of free nodes inside a
+    /// ring of fixed ones, every cable in the set.
+    fn grid_lp(n: usize) -> RatioLp<2> {
+        let id = |i: usize, j: usize| {
+            (1..=n)
+                .contains(&i)
+                .then_some(())
+                .and((1..=n).contains(&j).then_some((i - 1) * n + j - 1))
+        };
+        let (mut ends, mut vectors, mut lengths) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..=n + 1 {
+            for j in 0..=n + 1 {
+                for (di, dj) in [(1, 0), (0, 1), (1, 1)] {
+                    let (a, b) = (id(i, j), id(i + di, j + dj));
+                    if i + di <= n + 1 && j + dj <= n + 1 && (a.is_some() || b.is_some()) {
+                        // A slightly sheared grid: no two cables alike.
+                        let u = [di as f64 + 0.01 * j as f64, dj as f64 + 0.02 * i as f64];
+                        ends.push([a, b]);
+                        vectors.push(u);
+                        lengths.push(u[0].hypot(u[1]));
+                    }
+                }
+            }
+        }
+        let m = ends.len();
+        RatioLp {
+            n_free: n * n,
+            ends,
+            vectors,
+            lengths,
+            in_set: vec![true; m],
+            min_other_tension: 1.0,
+        }
+    }
+
+    /// The solves with the factor's own supernodal kernel agree with faer's
+    /// supernodal solve to rounding (they differ only in the order of the
+    /// sums; measured 5·10⁻¹⁴ of the solution), with `Θ` spanning twelve
+    /// orders of magnitude (as near an optimum).
+    #[test]
+    fn own_supernodal_solve_matches_faer() {
+        let lp = grid_lp(60);
+        let mut normal = NormalMatrix::new(&lp, &IpmSettings::plan()).expect("normal matrix");
+        assert!(
+            normal.supernodes.is_some(),
+            "faer chose a simplicial factor"
+        );
+        let m = lp.ends.len();
+        let theta: Vec<f64> = (0..m)
+            .map(|k| 10f64.powi((k * 7919 % 13) as i32 - 6))
+            .collect();
+        normal.factorize(&theta).expect("factor");
+        let b: Vec<f64> = (0..normal.n_rows)
+            .map(|i| ((i * 37 % 101) as f64 - 50.0) / 50.0)
+            .collect();
+        let mut own = b.clone();
+        normal.precondition(&mut own);
+        let mut reference: Vec<f64> = b.iter().zip(&normal.scale).map(|(v, s)| v * s).collect();
+        let n = normal.n_rows;
+        LltRef::new(&normal.symbolic, &normal.factor).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut reference, n, 1),
+            Par::Seq,
+            MemStack::new(&mut normal.buffer),
+        );
+        reference
+            .iter_mut()
+            .zip(&normal.scale)
+            .for_each(|(v, s)| *v *= s);
+        let scale = norm_inf(&reference);
+        let difference = own
+            .iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            difference <= 1e-12 * scale,
+            "own solve differs by {difference:e} of {scale:e}"
+        );
     }
 }
