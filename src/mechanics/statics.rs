@@ -208,16 +208,19 @@ impl Linearisation<'_> {
         let mut previous = f64::INFINITY;
         let mut ev = system.evaluate(changed, &state, self.lambda);
         // Whether the last step was Newton's (the tangent refactored where
-        // it was taken): after a chord step the force test alone is not
-        // enough — the iterations converge linearly, so the state is only
-        // as good as that test, while after Newton's it is far better (the
-        // budget's scaled-dish test asks tensions to 1e-9, which a chord
-        // iterate passing the force test missed by 10×). Chord iterations
-        // go on to the increment test instead: each is cheap.
-        let mut newton = true;
+        // it was taken), and whether it was taken after the force test
+        // passed: after a chord step that test alone is not enough — the
+        // iterations converge linearly, so the state is only as good as the
+        // test (the budget's scaled-dish test asks tensions to 1e-9, which a
+        // chord iterate passing the force test missed by 10×) — so chord
+        // steps go on, cheap, to the increment test, at most
+        // [`POLISHING_STEPS`] and with no refactorisation (once at the
+        // roundoff, an increment need not shrink: on super-100m's design
+        // that refactored at every iteration, 40 times).
+        let (mut newton, mut polished) = (true, 0);
         for iteration in 0..=settings.max_iterations {
             let converged = self.solver.converged(&ev, self.lambda, settings).1;
-            if converged && newton {
+            if converged && (newton || polished == POLISHING_STEPS) {
                 return Ok(Some((state, iteration)));
             }
             if iteration == settings.max_iterations {
@@ -226,7 +229,8 @@ impl Linearisation<'_> {
             let (mut delta, mut size) =
                 step(refreshed.as_ref().unwrap_or(&self.factor), &ev.residual);
             newton = false;
-            if size.is_nan() || size > CHORD_CONTRACTION * previous {
+            polished += usize::from(converged);
+            if !converged && (size.is_nan() || size > CHORD_CONTRACTION * previous) {
                 if refactorisations == CHORD_REFACTORISATIONS {
                     return Ok(None);
                 }
@@ -274,6 +278,10 @@ impl Linearisation<'_> {
         Ok(None)
     }
 }
+
+/// Chord steps [`Linearisation::solve`] takes past its force test, to its
+/// increment test.
+const POLISHING_STEPS: usize = 3;
 
 /// Halvings of a step of [`Linearisation::solve`] whose residual grows.
 const LINE_SEARCH_HALVINGS: usize = 3;
