@@ -7,7 +7,9 @@
 //! * clarabel on the same plan LP (`tests/common/plan_lp.rs`), QDLDL and
 //!   faer backends,
 //! * ringmesh's `gradient` with the settings `ringmesh uniformity --solver
-//!   gradient` uses (from `lp`'s optimum, so its time includes an `lp`),
+//!   gradient` uses (from `lp`'s optimum, so its time includes an `lp`;
+//!   its route column counts the exact finish's programs and their
+//!   interior-point iterations),
 //!
 //! each timed as the best wall time of `RINGMESH_SIDE_REPEATS` solves
 //! (default 3; one solve on nets of more than 50 000 nodes, and no repeat
@@ -52,7 +54,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use ringmesh::report::json_name;
-use ringmesh::uniformity::{Lp, SolverKind, UniformityProblem, UniformitySolver};
+use ringmesh::uniformity::{Gradient, Lp, UniformityProblem, UniformitySolver};
 
 /// Relative ratio difference to `lp`'s beyond which a row is marked `NO`.
 const RATIO_TOLERANCE: f64 = 1e-6;
@@ -205,6 +207,50 @@ fn ringmesh_row(
     }
 }
 
+/// `gradient`'s row, with the settings of `ringmesh uniformity --solver
+/// gradient` (`SolverKind::Gradient`'s defaults); its route column says the
+/// exact finish's programs, their interior-point iterations and the warnings
+/// (each printed).
+fn gradient_row(repeats: usize, p: &UniformityProblem) -> Row {
+    let gradient = Gradient {
+        exact_finish: true,
+        ..Gradient::default()
+    };
+    let (outcome, time_s, solves) = best_of(repeats, || gradient.solve_with_history(p));
+    match outcome {
+        Ok((d, history)) => {
+            for w in &d.warnings {
+                eprintln!("    warning: {w}");
+            }
+            Row {
+                solver: "gradient",
+                backend: "",
+                route: format!(
+                    "exact finish: {} programs, {} interior-point iterations, {} warnings",
+                    history.finish_steps,
+                    history.finish_interior_iterations,
+                    d.warnings.len()
+                ),
+                iterations: d.iterations.to_string(),
+                status: json_name(&d.termination),
+                ratio: d.ratio,
+                time_s,
+                solves,
+            }
+        }
+        Err(e) => Row {
+            solver: "gradient",
+            backend: "",
+            route: String::new(),
+            iterations: String::new(),
+            status: format!("error: {e}"),
+            ratio: f64::NAN,
+            time_s,
+            solves,
+        },
+    }
+}
+
 /// Every solver on one net.
 fn measure(family: nets::Family, free_target: usize, settings: &Settings) -> NetRows {
     let p = family.problem(nets::rings_for(free_target));
@@ -243,11 +289,8 @@ fn measure(family: nets::Family, free_target: usize, settings: &Settings) -> Net
         .gradient
         .unwrap_or(free_target <= GRADIENT_DEFAULT_MAX_FREE)
     {
-        let gradient = SolverKind::Gradient
-            .configure(&serde_json::Map::new())
-            .expect("gradient's defaults are valid");
-        let row = ringmesh_row("gradient", repeats, gradient.as_ref(), &p);
-        eprintln!("  gradient {:.3} s", row.time_s);
+        let row = gradient_row(repeats, &p);
+        eprintln!("  gradient {:.3} s ({})", row.time_s, row.route);
         rows.push(row);
     }
     NetRows {
