@@ -16,7 +16,8 @@
 //! after a solve longer than 30 s). Prints a table and writes a CSV
 //! (`family, free_nodes, cables, solver, backend, route, iterations, status,
 //! ratio, ratio_rel_diff, agree, time_s, solves, time_over_lp,
-//! clarabel_best_over_lp, gradient_over_lp, load_1min`). `ratio_rel_diff` is
+//! clarabel_best_over_lp, gradient_over_lp, load_1min`), rewritten after
+//! every net so that a run stopped early keeps its rows. `ratio_rel_diff` is
 //! `|ratio − lp's ratio| / lp's ratio`; `agree` is `yes` within 1e-6, `NO`
 //! beyond it (and the run's exit status is then 1), `n/a` for `gradient`,
 //! whose geometry is free. `*_over_lp` are wall-time ratios against `lp`'s
@@ -50,7 +51,7 @@ mod nets;
 mod plan_lp;
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use ringmesh::report::json_name;
@@ -331,15 +332,9 @@ fn csv_field(text: &str) -> String {
     }
 }
 
-fn main() {
-    let settings = Settings::from_env();
-    let mut nets_rows = Vec::new();
-    for &free in &settings.free {
-        for &family in &settings.families {
-            nets_rows.push(measure(family, free, &settings));
-        }
-    }
-
+/// The CSV and the printed table of `nets_rows`, and how many rows disagree
+/// with `lp`'s ratio.
+fn tables(nets_rows: &[NetRows]) -> (String, String, usize) {
     let mut csv = String::from(
         "family,free_nodes,cables,solver,backend,route,iterations,status,ratio,\
          ratio_rel_diff,agree,time_s,solves,time_over_lp,clarabel_best_over_lp,\
@@ -350,7 +345,7 @@ fn main() {
          agree | time | × lp |\n|---|---:|---|---|---:|---|---:|---|---:|---:|\n",
     );
     let mut disagreements = 0;
-    for net in &nets_rows {
+    for net in nets_rows {
         let lp_ratio = net.rows[0].ratio;
         let lp_time = net.rows[0].time_s;
         let clarabel = ratio_text(best_time(net, "clarabel"), lp_time);
@@ -406,6 +401,28 @@ fn main() {
             .expect("writing to a String");
         }
     }
+    (csv, table, disagreements)
+}
+
+/// Writes `csv` to `path`, its folder made first.
+fn write_csv(path: &Path, csv: &str) {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).expect("the CSV's folder can be made");
+    }
+    std::fs::write(path, csv).expect("the CSV can be written");
+}
+
+fn main() {
+    let settings = Settings::from_env();
+    let mut nets_rows = Vec::new();
+    for &free in &settings.free {
+        for &family in &settings.families {
+            nets_rows.push(measure(family, free, &settings));
+            // After every net, so that a run stopped early keeps its rows.
+            write_csv(&settings.csv, &tables(&nets_rows).0);
+        }
+    }
+    let (csv, table, disagreements) = tables(&nets_rows);
     println!("{table}");
     println!("| family | free nodes | load | clarabel best / lp | gradient / lp |");
     println!("|---|---:|---:|---:|---:|");
@@ -420,10 +437,7 @@ fn main() {
             ratio_text(best_time(net, "gradient"), lp_time)
         );
     }
-    if let Some(dir) = settings.csv.parent() {
-        std::fs::create_dir_all(dir).expect("the CSV's folder can be made");
-    }
-    std::fs::write(&settings.csv, csv).expect("the CSV can be written");
+    write_csv(&settings.csv, &csv);
     println!("\nwritten {}", settings.csv.display());
     if disagreements > 0 {
         eprintln!(
