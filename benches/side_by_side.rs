@@ -31,7 +31,7 @@
 //! * `RINGMESH_SIDE_FAMILIES` — comma-separated families (default all);
 //! * `RINGMESH_SIDE_REPEATS` — solves per timing (default 3);
 //! * `RINGMESH_SIDE_GRADIENT` — `1` runs `gradient` at every size, `0` at
-//!   none (default: up to ~10⁴ free nodes, ≈ 15 min a net at 10⁵);
+//!   none (default: up to ~10⁴ free nodes; at 10⁵ over half an hour a net);
 //! * `RINGMESH_SIDE_CSV` — the CSV's path (default
 //!   `target/side-by-side.csv`; a first argument not starting with `-`
 //!   overrides both).
