@@ -24,7 +24,10 @@
 //! * `clarabel_plan_lp` — clarabel on the same plan LPs (written from the
 //!   network in `tests/common/plan_lp.rs`), QDLDL and faer backends, ids
 //!   `<backend>/<family>/<free nodes>`, so the ratio to `lp_families` is
-//!   measured in one run (`cargo bench --bench uniformity -- 'lp_families|clarabel_plan_lp'`);
+//!   measured in one run (`cargo bench --bench uniformity -- 'lp_families|clarabel_plan_lp'`;
+//!   `benches/side_by_side.rs`, run by `scripts/bench/side-by-side.sh`,
+//!   times both and `gradient` side by side and writes the ratios to
+//!   `results/bench/side-by-side.csv`);
 //! * `gradient_nodes` — the `gradient` solver on the paper scene with 3 rings
 //!   (362 net nodes);
 //! * `gradient_independent` — the `gradient` solver (L-BFGS from afar, then
