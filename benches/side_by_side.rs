@@ -80,6 +80,27 @@ struct Row {
     solves: usize,
 }
 
+impl Row {
+    /// The row of a solve of `solver` that failed with `error`.
+    fn failed(
+        solver: &'static str,
+        error: &dyn std::fmt::Display,
+        time_s: f64,
+        solves: usize,
+    ) -> Self {
+        Row {
+            solver,
+            backend: "",
+            route: String::new(),
+            iterations: String::new(),
+            status: format!("error: {error}"),
+            ratio: f64::NAN,
+            time_s,
+            solves,
+        }
+    }
+}
+
 /// One net: its family, size and the rows of its solvers.
 #[derive(Debug)]
 struct NetRows {
@@ -196,16 +217,7 @@ fn ringmesh_row(
             time_s,
             solves,
         },
-        Err(e) => Row {
-            solver,
-            backend: "",
-            route: String::new(),
-            iterations: String::new(),
-            status: format!("error: {e}"),
-            ratio: f64::NAN,
-            time_s,
-            solves,
-        },
+        Err(e) => Row::failed(solver, &e, time_s, solves),
     }
 }
 
@@ -240,16 +252,7 @@ fn gradient_row(repeats: usize, p: &UniformityProblem) -> Row {
                 solves,
             }
         }
-        Err(e) => Row {
-            solver: "gradient",
-            backend: "",
-            route: String::new(),
-            iterations: String::new(),
-            status: format!("error: {e}"),
-            ratio: f64::NAN,
-            time_s,
-            solves,
-        },
+        Err(e) => Row::failed("gradient", &e, time_s, solves),
     }
 }
 

@@ -101,6 +101,15 @@ fn iterations_stay_within_their_bounds_at_2431_free_nodes() {
     }
 }
 
+/// Free-node counts from the comma-separated variable `var`, else `default`.
+fn sizes(var: &str, default: &str) -> Vec<usize> {
+    std::env::var(var)
+        .unwrap_or_else(|_| default.into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect()
+}
+
 /// The table of issue 38: iterations and ratio per family at the sizes of
 /// `RINGMESH_IPM_FREE` (default 1 000 and 10 000 free nodes). Measurement,
 /// not a check: `cargo test --release --test ipm_families -- --ignored
@@ -108,12 +117,7 @@ fn iterations_stay_within_their_bounds_at_2431_free_nodes() {
 #[test]
 #[ignore = "measurement: prints a table"]
 fn iteration_table() {
-    let sizes: Vec<usize> = std::env::var("RINGMESH_IPM_FREE")
-        .unwrap_or_else(|_| "1000,10000".into())
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect();
-    for free in sizes {
+    for free in sizes("RINGMESH_IPM_FREE", "1000,10000") {
         for family in Family::ALL {
             let rings = rings_for(free);
             let problem = family.problem(rings);
@@ -144,12 +148,7 @@ fn iteration_table() {
 #[test]
 #[ignore = "measurement: prints a table"]
 fn finish_table() {
-    let sizes: Vec<usize> = std::env::var("RINGMESH_FINISH_FREE")
-        .unwrap_or_else(|_| "10000".into())
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect();
-    for free in sizes {
+    for free in sizes("RINGMESH_FINISH_FREE", "10000") {
         for family in Family::ALL {
             let problem = family.problem(rings_for(free));
             let (design, history) = Gradient::default()

@@ -63,19 +63,7 @@ const BALANCE: f64 = 0.15;
 pub(crate) fn fill_reducing(
     graph: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Ordering, OrderingError> {
-    let n = graph.nrows();
-    let mut perm = vec![0usize; n];
-    let mut perm_inv = vec![0usize; n];
-    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n, graph.compute_nnz()))
-        .map_err(|_| OrderingError::OutOfMemory)?;
-    amd::order(
-        &mut perm,
-        &mut perm_inv,
-        graph,
-        amd::Control::default(),
-        MemStack::new(&mut mem),
-    )
-    .map_err(OrderingError::Faer)?;
+    let (perm, perm_inv) = amd_order(graph)?;
     let amd_nnz = factor_nnz(graph, &perm, &perm_inv)?;
     let dissection = nested_dissection(graph);
     let inverse = inverse(&dissection);
@@ -88,6 +76,28 @@ pub(crate) fn fill_reducing(
     } else {
         Ordering { perm, perm_inv }
     })
+}
+
+/// faer's AMD ordering of `graph`: the permutation and its inverse.
+///
+/// # Errors
+/// [`OrderingError`] when its workspace cannot be allocated or faer fails.
+fn amd_order(
+    graph: SymbolicSparseColMatRef<'_, usize>,
+) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
+    let n = graph.nrows();
+    let (mut perm, mut perm_inv) = (vec![0usize; n], vec![0usize; n]);
+    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n, graph.compute_nnz()))
+        .map_err(|_| OrderingError::OutOfMemory)?;
+    amd::order(
+        &mut perm,
+        &mut perm_inv,
+        graph,
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(OrderingError::Faer)?;
+    Ok((perm, perm_inv))
 }
 
 /// The inverse of the permutation `perm`.
@@ -422,24 +432,9 @@ fn amd_leaves(adjacency: &Adjacency, perm: &mut [usize], leaves: &[(usize, usize
             row_idx.extend(rows);
             col_ptr.push(row_idx.len());
         }
-        let nnz = row_idx.len();
         let graph =
             faer::sparse::SymbolicSparseColMat::new_checked(len, len, col_ptr, None, row_idx);
-        let mut p = vec![0usize; len];
-        let mut p_inv = vec![0usize; len];
-        let Ok(mut mem) = MemBuffer::try_new(amd::order_scratch::<usize>(len, nnz)) else {
-            continue;
-        };
-        let control = amd::Control::default();
-        if amd::order(
-            &mut p,
-            &mut p_inv,
-            graph.as_ref(),
-            control,
-            MemStack::new(&mut mem),
-        )
-        .is_ok()
-        {
+        if let Ok((p, _)) = amd_order(graph.as_ref()) {
             for (k, &q) in p.iter().enumerate() {
                 perm[first + k] = nodes[q];
             }
@@ -492,17 +487,7 @@ mod tests {
     }
 
     fn amd_nnz(graph: SymbolicSparseColMatRef<'_, usize>) -> usize {
-        let n = graph.nrows();
-        let (mut perm, mut perm_inv) = (vec![0; n], vec![0; n]);
-        let mut mem = MemBuffer::new(amd::order_scratch::<usize>(n, graph.compute_nnz()));
-        amd::order(
-            &mut perm,
-            &mut perm_inv,
-            graph,
-            amd::Control::default(),
-            MemStack::new(&mut mem),
-        )
-        .expect("amd");
+        let (perm, perm_inv) = amd_order(graph).expect("amd");
         factor_nnz(graph, &perm, &perm_inv).expect("symbolic")
     }
 
