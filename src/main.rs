@@ -18,6 +18,7 @@ use cli::{Cli, Command};
 use progress::{bar, DesignProgress, SizeProgress};
 
 fn main() -> ExitCode {
+    ringmesh::resources::retain_freed_memory();
     let cli = Cli::parse();
     ringmesh::resources::set_memory_limit(cli.max_memory);
     // SIGINT, SIGTERM, SIGHUP: no staging folder or temporary file is left.
