@@ -127,6 +127,7 @@ fn one(name: &str, samples: usize) {
 }
 
 fn main() {
+    ringmesh::resources::retain_freed_memory();
     let args: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with('-'))

@@ -605,3 +605,44 @@ fn a_design_ignores_the_budget_sections() {
         plain_run.report.verification.rms_mm
     );
 }
+
+#[test]
+fn chord_iterations_through_slackening_cables_find_newtons_equilibrium() {
+    // At σ = 0.3 mm the samples slacken cables: the chord iterations then
+    // refactor a matrix in which slack cables keep 1 % of their stiffness
+    // (`SLACK_ITERATION_RATIO`), not the tangent. Its residual is exact, so
+    // the equilibrium must still be Newton's from the load ramp: the same
+    // positions to the solvers' tolerance and the same slack cables.
+    let (scene, run) = designed();
+    let core = core(&scene, &run);
+    let tangent = core.linearise().expect("factored");
+    let model = ToleranceModel::new(
+        &tolerances(3e-4, 0.0),
+        &run.mesh,
+        &run.network,
+        &run.report.net,
+        &scene.cables,
+    );
+    let mut slackened = 0;
+    for k in 0..4 {
+        let p = model.sample(11, k);
+        let newton = core.newton(&p).expect("Newton assembles");
+        let chord = core
+            .chord(&tangent, &p)
+            .expect("a perturbation of the right size")
+            .unwrap_or_else(|| panic!("sample {k}: the chord iterations did not converge"));
+        let gap = chord
+            .nodes_xyz_m
+            .iter()
+            .zip(&newton.nodes_xyz_m)
+            .map(|(a, b)| distance(*a, *b))
+            .fold(0.0, f64::max);
+        assert!(
+            gap < 1e-10 * scene.reflector.aperture_diameter_m,
+            "sample {k}: chord and Newton differ by {gap:e} m"
+        );
+        assert_eq!(chord.slack_cables, newton.slack_cables, "sample {k}");
+        slackened += usize::from(!newton.slack_cables.is_empty());
+    }
+    assert!(slackened >= 3, "{slackened} of 4 samples slackened a cable");
+}

@@ -24,6 +24,7 @@ use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatMut};
 use rayon::prelude::*;
 
+use super::cable::SLACK_STIFFNESS_RATIO;
 use super::condensed::{Condensation, CondensedError, CondensedFactor};
 use super::joint::ConstraintRow;
 use super::model::{MechanicsError, Model};
@@ -326,6 +327,19 @@ impl System {
     /// Residual `F = f_int + s Gᵀμ − λ f_ext` (free components), `s g` (joint
     /// rows), and the tangent values, at `state` and load factor `lambda`.
     pub fn evaluate(&self, model: &Model, state: &State, lambda: f64) -> Evaluation {
+        self.evaluate_with(model, state, lambda, SLACK_STIFFNESS_RATIO)
+    }
+
+    /// [`System::evaluate`] with an iteration matrix in place of the
+    /// tangent: slack cables keep `slack_tangent_ratio × EA` of axial
+    /// stiffness in it (the residual is the same).
+    pub(crate) fn evaluate_with(
+        &self,
+        model: &Model,
+        state: &State,
+        lambda: f64,
+        slack_tangent_ratio: f64,
+    ) -> Evaluation {
         let n_nodes = model.node_count();
         let mut full = vec![[0.0f64; 6]; n_nodes];
         let mut values = Vec::with_capacity(self.pattern.len());
@@ -365,6 +379,7 @@ impl System {
                 &state.frames[a].position_m,
                 &state.frames[b].position_m,
                 lambda,
+                slack_tangent_ratio,
             );
             prestress_scale = prestress_scale.max(f.amax());
             for comp in 0..3 {

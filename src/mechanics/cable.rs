@@ -79,18 +79,27 @@ impl Cable {
     /// Internal force on the end node `b` (the force on `a` is its negative),
     /// `T e` with `e = (b − a)/ℓ`, and its derivative with respect to `x_b`:
     /// `k = (EA/L₀) e eᵀ + (T/ℓ)(I − e eᵀ)` (the element tangent is
-    /// `[k −k; −k k]`).
+    /// `[k −k; −k k]`), where a slack cable's axial term is
+    /// `slack_tangent_ratio × EA/L₀`: [`SLACK_STIFFNESS_RATIO`] for the
+    /// exact derivative, more for an iteration matrix that keeps part of a
+    /// slack cable's stiffness (the force is the same either way).
     pub(crate) fn force_tangent(
         &self,
         a: &Vector3<f64>,
         b: &Vector3<f64>,
         lambda: f64,
+        slack_tangent_ratio: f64,
     ) -> (Vector3<f64>, Matrix3<f64>) {
         let u = b - a;
         let s = self.state(a, b, lambda);
         let e = u / s.length_m;
         let eet = e * e.transpose();
-        let axial = self.modulus(s.slack) / self.rest_length_m(lambda);
+        let modulus = if s.slack {
+            slack_tangent_ratio * self.axial_n
+        } else {
+            self.axial_n
+        };
+        let axial = modulus / self.rest_length_m(lambda);
         let k = eet * axial + (Matrix3::identity() - eet) * (s.tension_n / s.length_m);
         (e * s.tension_n, k)
     }
@@ -124,13 +133,13 @@ mod tests {
         let c = cable();
         let a = Vector3::new(0.1, -0.2, 0.3);
         for b in [Vector3::new(1.7, 0.9, -0.4), Vector3::new(0.9, 0.5, 0.2)] {
-            let (_, k) = c.force_tangent(&a, &b, 0.7);
+            let (_, k) = c.force_tangent(&a, &b, 0.7, SLACK_STIFFNESS_RATIO);
             let h = 1e-6;
             for j in 0..3 {
                 let mut d = Vector3::zeros();
                 d[j] = h;
-                let fd = (c.force_tangent(&a, &(b + d), 0.7).0
-                    - c.force_tangent(&a, &(b - d), 0.7).0)
+                let fd = (c.force_tangent(&a, &(b + d), 0.7, SLACK_STIFFNESS_RATIO).0
+                    - c.force_tangent(&a, &(b - d), 0.7, SLACK_STIFFNESS_RATIO).0)
                     / (2.0 * h);
                 let scale = k.amax();
                 assert!(
@@ -140,5 +149,24 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// An iteration matrix's slack ratio changes a slack cable's axial
+    /// stiffness only: not its force, not a taut cable.
+    #[test]
+    fn a_slack_tangent_ratio_changes_only_a_slack_cables_axial_stiffness() {
+        let c = cable();
+        let a = Vector3::new(0.1, -0.2, 0.3);
+        let slack = Vector3::new(0.9, 0.5, 0.2);
+        let taut = Vector3::new(1.7, 0.9, -0.4);
+        let (f0, k0) = c.force_tangent(&a, &taut, 0.7, SLACK_STIFFNESS_RATIO);
+        let (f1, k1) = c.force_tangent(&a, &taut, 0.7, 0.01);
+        assert_eq!((f0, k0), (f1, k1));
+        let (f0, k0) = c.force_tangent(&a, &slack, 0.7, SLACK_STIFFNESS_RATIO);
+        let (f1, k1) = c.force_tangent(&a, &slack, 0.7, 0.01);
+        assert_eq!(f0, f1);
+        let e = (slack - a).normalize();
+        let extra = (0.01 - SLACK_STIFFNESS_RATIO) * c.axial_n / c.rest_length_m(0.7);
+        assert!((k1 - k0 - e * e.transpose() * extra).amax() <= 1e-9 * extra);
     }
 }
