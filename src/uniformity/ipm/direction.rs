@@ -151,7 +151,13 @@ impl Program {
     /// One Newton direction for the current iterate, in the driver's form
     /// (`dx, dw | dz, dλ | ds | dy`): the reduction
     /// ([`Program::direction_once`]) as a right preconditioner of FGMRES on
-    /// the rows it solves only up to the factor's regularisation.
+    /// the rows it solves only up to the factor's regularisation. FGMRES
+    /// stops at [`IpmSettings::krylov_tolerance`] of those rows' right-hand
+    /// side or at `floor`, whichever is larger (an absolute 2-norm); returns
+    /// the direction and the 2-norm of its residual in those rows (0 where
+    /// the reduction is taken as it is).
+    ///
+    /// [`IpmSettings::krylov_tolerance`]: super::settings::IpmSettings::krylov_tolerance
     #[allow(clippy::too_many_arguments)]
     pub(super) fn direction<const D: usize>(
         &self,
@@ -162,7 +168,8 @@ impl Program {
         w: &[f64],
         lam: &[f64],
         rhs: &Rhs,
-    ) -> Point {
+        floor: f64,
+    ) -> (Point, f64) {
         let (m, p, n) = (self.m, self.set.len(), normal.n_rows);
         let mut d = self.direction_once(normal, sc, x, z, w, lam, rhs);
         // Measured limitation: on the full 3-D problem, whose `A` has dependent
@@ -170,7 +177,7 @@ impl Program {
         // reduced accuracy; there the reduction alone converges. The plan
         // problem (D = 2, a triangulated plan net) is where FGMRES is needed.
         if D == 3 {
-            return d;
+            return (d, 0.0);
         }
         // Rows the reduction solves only up to the factor's regularisation:
         // A dx = r_p, dw + E dx − ds e = −r_w, eᵀdλ = r_s. The other rows hold
@@ -187,9 +194,9 @@ impl Program {
         self.krylov_rows(normal, &d, &mut kd);
         let mut r: Vec<f64> = f.iter().zip(&kd).map(|(a, b)| a - b).collect();
         let beta = norm2(&r);
-        let tolerance = self.settings.krylov_tolerance * f_norm;
+        let tolerance = (self.settings.krylov_tolerance * f_norm).max(floor);
         if beta.is_nan() || beta <= tolerance {
-            return d;
+            return (d, beta);
         }
         let zero_m = vec![0.0; m];
         let zero_p = vec![0.0; p];
@@ -199,6 +206,7 @@ impl Program {
         let mut h: Vec<Vec<f64>> = Vec::new();
         let (mut cs, mut sn): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
         let mut g = vec![beta];
+        let mut residual = beta;
         let mut rw = vec![0.0; p];
         for it in 0..self.settings.krylov_steps {
             let v = &basis[it];
@@ -250,6 +258,7 @@ impl Program {
             h.push(col);
             zs.push(zj);
             let res = g[it + 1].abs();
+            residual = res;
             if res <= tolerance || wn == 0.0 || !res.is_finite() {
                 break;
             }
@@ -269,7 +278,7 @@ impl Program {
         for (zi, yi) in zs.iter().zip(&y) {
             d.add_scaled(*yi, zi);
         }
-        d
+        (d, residual)
     }
 
     /// The rows of the Newton system that FGMRES works on, applied to `d`:

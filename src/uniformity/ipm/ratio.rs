@@ -47,6 +47,7 @@ pub(crate) fn solve<const D: usize>(
         rw: vec![0.0; p],
         rs: 0.0,
         scaling: None,
+        corrector_residual: 0.0,
     };
     let outcome = driver::run(&mut system, settings);
     let Some(point) = outcome.point else {
@@ -149,6 +150,9 @@ struct LpSystem<'a, const D: usize> {
     rs: f64,
     /// The scaling of the last factorisation.
     scaling: Option<Scaling>,
+    /// The 2-norm of the last corrector's residual in the rows FGMRES
+    /// completes: the tolerance of the centrality corrections that follow.
+    corrector_residual: f64,
 }
 
 /// The LP's parts of a point: `(x, w | z, λ)`, the ratio `s` and `y`.
@@ -318,7 +322,18 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
         } else {
             (&self.rp[..], &self.rw[..], &self.rd[..], self.rs)
         };
-        Ok(program.direction(
+        // A centrality correction `c` has zero residual rows, so a tolerance
+        // relative to them is zero and FGMRES would always run all its steps.
+        // It is added to the corrector `d`, whose residual in those rows is
+        // `corrector_residual`: solving `c` beyond that leaves `d + c` no more
+        // accurate (its residual is at most twice `d`'s), so FGMRES stops
+        // there.
+        let floor = if rhs == Rhs::Centrality {
+            self.corrector_residual
+        } else {
+            0.0
+        };
+        let (d, residual) = program.direction(
             &mut self.normal,
             sc,
             x,
@@ -333,6 +348,11 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
                 rxz,
                 rwl,
             },
-        ))
+            floor,
+        );
+        if rhs == Rhs::Corrector {
+            self.corrector_residual = residual;
+        }
+        Ok(d)
     }
 }

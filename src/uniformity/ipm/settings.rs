@@ -72,7 +72,14 @@ pub(crate) struct IpmSettings {
     pub separate_steps: bool,
     /// Gondzio's centrality correctors per iteration (at most; each is one
     /// more Newton solve with the iteration's factor, kept while it lengthens
-    /// the step by 1 %).
+    /// the step by 1 %). None by default: on the three net families of issue
+    /// 38 at 9 913 free nodes, 1/2/3 correctors took hex 24 → 20/20/18,
+    /// sector 16 → 15/14/13 and jitter 64 → 56/49/47 iterations, but the time
+    /// fell on none of them (hex 1.18–1.27 s → 1.20–1.24 s, sector 0.58–0.64
+    /// → 0.63–0.67 s, jitter 2.6–3.0 → 2.9–3.2 s, one run, load ≈ 2.7): near
+    /// the optimum each correction's FGMRES completion needs most of its
+    /// [`Self::krylov_steps`] solves, like the corrector's, and the solves
+    /// are most of an iteration's time.
     pub centrality_correctors: usize,
     /// The ratio LP's starting point.
     pub start: Start,
@@ -107,7 +114,8 @@ pub(crate) struct IpmSettings {
     /// FGMRES steps per Newton direction of the plan LP (at most) …
     pub krylov_steps: usize,
     /// … and their target for the rows the factor solves inexactly, relative
-    /// to their right-hand side.
+    /// to their right-hand side (a centrality correction, whose rows are
+    /// zero, stops at the corrector's residual instead: `ratio.rs`).
     pub krylov_tolerance: f64,
     /// The finish's least first slack of a row (the rows are in units of
     /// `ln T` and of relative `δq`): 0.1 took 10 iterations a program where

@@ -129,3 +129,37 @@ fn settings_out_of_range_are_named() {
     }
     assert!(IpmSettings::default().validate().is_ok());
 }
+
+/// `Tmax/Tmin` of a ratio LP's set for its (unscaled) `q`.
+fn lp_ratio<const D: usize>(lp: &RatioLp<D>, q: &[f64]) -> f64 {
+    let (min, max) = (0..q.len())
+        .filter(|&k| lp.in_set[k])
+        .map(|k| q[k] * lp.lengths[k])
+        .fold((f64::INFINITY, 0.0f64), |(a, b), t| (a.min(t), b.max(t)));
+    max / min
+}
+
+/// Gondzio's centrality correctors (off by default) reach the plan optimum of
+/// the default plan settings: a correction's FGMRES, which stops at the
+/// corrector's residual, leaves the direction as exact as the corrector.
+#[test]
+fn centrality_correctors_reach_the_same_plan_optimum() {
+    let problem = problem("problems/paper-26m.toml");
+    let plan = crate::uniformity::plan::PlanReduction::new(&problem).expect("a reflector mesh");
+    let reference = solve(plan.lp(), &IpmSettings::plan()).expect("plan");
+    assert_eq!(reference.termination, Termination::Converged);
+    let reference_ratio = lp_ratio(plan.lp(), &reference.q);
+    for correctors in 1..=3 {
+        let settings = IpmSettings {
+            centrality_correctors: correctors,
+            ..IpmSettings::plan()
+        };
+        let solution = solve(plan.lp(), &settings).expect("plan");
+        assert_eq!(solution.termination, Termination::Converged, "{correctors}");
+        let ratio = lp_ratio(plan.lp(), &solution.q);
+        assert!(
+            (ratio / reference_ratio - 1.0).abs() <= 1e-8,
+            "{correctors} correctors: {ratio} vs {reference_ratio}"
+        );
+    }
+}
