@@ -127,6 +127,7 @@ fn one(name: &str, samples: usize) {
 }
 
 fn main() {
+    // As the command line does (`resources::retain_freed_memory`).
     ringmesh::resources::retain_freed_memory();
     let args: Vec<String> = std::env::args()
         .skip(1)

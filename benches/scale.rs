@@ -66,6 +66,8 @@ fn one(name: &str) {
 }
 
 fn main() {
+    // As the command line does (`resources::retain_freed_memory`).
+    ringmesh::resources::retain_freed_memory();
     let args: Vec<String> = std::env::args().skip(1).collect();
     if let Some(i) = args.iter().position(|a| a == "--one") {
         one(&args[i + 1]);
