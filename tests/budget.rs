@@ -184,6 +184,11 @@ fn tolerances(sigma_m: f64, ea: f64) -> Tolerances {
     }
 }
 
+/// The tolerance model `t` of the design `run` of `scene`.
+fn tolerance_model(scene: &Scene, run: &DesignRun, t: &Tolerances) -> ToleranceModel {
+    ToleranceModel::new(t, &run.mesh, &run.network, &run.report.net, &scene.cables)
+}
+
 /// Rows of `n` samples of `t` (seed 7), nonlinear and linearised.
 fn samples(
     core: &PerturbedAssembly<'_>,
@@ -192,7 +197,7 @@ fn samples(
     t: &Tolerances,
     n: usize,
 ) -> Vec<BudgetRow> {
-    let model = ToleranceModel::new(t, &run.mesh, &run.network, &run.report.net, &scene.cables);
+    let model = tolerance_model(scene, run, t);
     let tangent = core.linearise().expect("factored");
     (0..n)
         .map(|k| {
@@ -218,13 +223,7 @@ fn samples(
 fn tolerances_at_zero_sigma_return_the_design_as_built() {
     let (scene, run) = designed();
     let core = core(&scene, &run);
-    let model = ToleranceModel::new(
-        &tolerances(0.0, 0.0),
-        &run.mesh,
-        &run.network,
-        &run.report.net,
-        &scene.cables,
-    );
+    let model = tolerance_model(&scene, &run, &tolerances(0.0, 0.0));
     let tangent = core.linearise().expect("factored");
     let built = core
         .nonlinear(&tangent, &model.sample(3, 0))
@@ -312,13 +311,7 @@ fn chord_iterations_on_the_designs_tangent_find_newtons_equilibrium() {
     let (scene, run) = designed();
     let core = core(&scene, &run);
     let tangent = core.linearise().expect("factored");
-    let model = ToleranceModel::new(
-        &tolerances(1e-5, 0.2),
-        &run.mesh,
-        &run.network,
-        &run.report.net,
-        &scene.cables,
-    );
+    let model = tolerance_model(&scene, &run, &tolerances(1e-5, 0.2));
     let mut chords = 0;
     for k in 0..6 {
         let p = model.sample(11, k);
@@ -616,13 +609,7 @@ fn chord_iterations_through_slackening_cables_find_newtons_equilibrium() {
     let (scene, run) = designed();
     let core = core(&scene, &run);
     let tangent = core.linearise().expect("factored");
-    let model = ToleranceModel::new(
-        &tolerances(3e-4, 0.0),
-        &run.mesh,
-        &run.network,
-        &run.report.net,
-        &scene.cables,
-    );
+    let model = tolerance_model(&scene, &run, &tolerances(3e-4, 0.0));
     let mut slackened = 0;
     for k in 0..4 {
         let p = model.sample(11, k);

@@ -9,13 +9,12 @@ mod common;
 
 use common::nets::{rings_for, Family};
 use common::plan_lp;
-use ringmesh::uniformity::{Gradient, Lp, Route, UniformitySolver};
+use ringmesh::uniformity::{Design, Gradient, Lp, Route, UniformityProblem, UniformitySolver};
 
-/// The plan interior point's result on `family` at `rings` rows against
-/// clarabel's on the same plan LP.
-fn matches_clarabel(family: Family, rings: usize) -> usize {
-    let problem = family.problem(rings);
-    let design = Lp.solve(&problem).expect("lp");
+/// `lp`'s design of `problem` (a net of `family`), which must take the plan
+/// interior point without a warning.
+fn plan_design(family: Family, problem: &UniformityProblem) -> Design {
+    let design = Lp.solve(problem).expect("lp");
     assert_eq!(
         design.route,
         Some(Route::PlanInteriorPoint),
@@ -23,7 +22,20 @@ fn matches_clarabel(family: Family, rings: usize) -> usize {
         family.name(),
         design.warnings
     );
-    assert!(design.warnings.is_empty(), "{:?}", design.warnings);
+    assert!(
+        design.warnings.is_empty(),
+        "{}: {:?}",
+        family.name(),
+        design.warnings
+    );
+    design
+}
+
+/// The plan interior point's result on `family` at `rings` rows against
+/// clarabel's on the same plan LP.
+fn matches_clarabel(family: Family, rings: usize) -> usize {
+    let problem = family.problem(rings);
+    let design = plan_design(family, &problem);
     let reference = plan_lp::solve_plan(&problem, "qdldl");
     assert_eq!(reference.status, "Solved", "{}", family.name());
     assert!(
@@ -78,20 +90,7 @@ fn iterations_stay_within_their_bounds_at_2431_free_nodes() {
             "{}",
             family.name()
         );
-        let design = Lp.solve(&problem).expect("lp");
-        assert_eq!(
-            design.route,
-            Some(Route::PlanInteriorPoint),
-            "{}: {:?}",
-            family.name(),
-            design.warnings
-        );
-        assert!(
-            design.warnings.is_empty(),
-            "{}: {:?}",
-            family.name(),
-            design.warnings
-        );
+        let design = plan_design(family, &problem);
         assert!(
             design.iterations <= bound,
             "{}: {} iterations, bound {bound}",
