@@ -367,6 +367,55 @@ fn the_pull_of_the_design_moves_linearly_with_the_boundary() {
     }
 }
 
+/// The outer loop starts each plan LP from the previous boundary's iterate
+/// (`lp`'s [`WarmStart`](ringmesh::uniformity::WarmStart)): from there, at
+/// a boundary moved as the loop moves it, the LP reaches the optimum the
+/// cold solve reaches, in fewer iterations — the same ratio, and a pull
+/// whose difference from the cold one is small beside the boundary's own
+/// effect on it.
+#[test]
+fn a_plan_lp_from_the_neighbouring_boundarys_iterate_reaches_the_cold_optimum() {
+    for name in ["small-hex", "realistic-26m"] {
+        let scene = common::scene(name);
+        let (mesh, problem) = scene_problem(&scene).unwrap();
+        let nets = TiedNets::new(&mesh, problem).unwrap();
+        let solver = SolverKind::Lp.build(None);
+        let c0 = layout_points(&mesh.truss);
+        let first = nets.design(solver.as_ref(), &c0).unwrap();
+        assert!(first.front.warm_start.is_some(), "{name}: no iterate kept");
+        for h in [1e-6, 1e-5, 1e-4] {
+            let n = mesh.truss.bays();
+            let moved: Vec<[f64; 3]> = c0
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let r = p[0].hypot(p[1]);
+                    let s = if i < n { 1.0 - h / r } else { 1.0 };
+                    [p[0] * s, p[1] * s, p[2]]
+                })
+                .collect();
+            let cold = nets.design(solver.as_ref(), &moved).unwrap().design;
+            let warm = nets
+                .design_from(solver.as_ref(), &moved, Some(&first))
+                .unwrap()
+                .design;
+            let pull_change = common::max_abs_diff(&cold.pull_n(), &first.design.pull_n());
+            let pull_gap = common::max_abs_diff(&warm.pull_n(), &cold.pull_n());
+            let context = format!(
+                "{name}, h = {h:e} m: {} iterations warm, {} cold; ratio {} warm, {} cold; \
+                 pull change {pull_change:.3e} N, warm − cold {pull_gap:.3e} N; warnings {:?}",
+                warm.iterations, cold.iterations, warm.ratio, cold.ratio, warm.warnings
+            );
+            // Measured: 3–4 iterations against 7–10, ratios within 3e-12,
+            // pulls within 7.2e-5 of the boundary's effect.
+            assert!(warm.warnings.is_empty(), "{context}");
+            assert!(2 * warm.iterations <= cold.iterations, "{context}");
+            assert!((warm.ratio / cold.ratio - 1.0).abs() <= 1e-9, "{context}");
+            assert!(pull_gap <= 1e-3 * pull_change, "{context}");
+        }
+    }
+}
+
 /// The design carries the mean tensions its scene asks for, front net and
 /// rear net, to 1e-9 — whatever solver made it and however coarse or sagged
 /// the net (issue 19: least squares' designs sank by `(mean T)²/mean(T²)`,

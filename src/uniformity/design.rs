@@ -5,11 +5,12 @@
 //! into an error for callers that cannot go on without one.
 
 use std::fmt;
+use std::sync::Arc;
 use std::time::Duration;
 
 use serde::Serialize;
 
-use super::{UniformityError, UniformityProblem};
+use super::{UniformityError, UniformityProblem, WarmStart};
 use crate::status::Termination;
 
 /// Relative miss of a set's mean tension within which a design holds its
@@ -159,6 +160,11 @@ pub struct Design {
     /// the nodes whose cables can only be slack (also in `warnings`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub slack_nodes: Option<SlackNodes>,
+    /// The interior point's iterate kept for the solve of a neighbouring
+    /// problem ([`super::UniformitySolver::solve_from`]: `lp`'s plan route,
+    /// the outer loop's next boundary). Not part of the design's files.
+    #[serde(skip)]
+    pub warm_start: Option<Arc<WarmStart>>,
 }
 
 impl Design {
@@ -241,6 +247,7 @@ impl Design {
         )?;
         design.route = self.route;
         design.slack_nodes = self.slack_nodes;
+        design.warm_start = self.warm_start;
         Ok(design)
     }
 
@@ -317,6 +324,7 @@ impl Design {
             warnings,
             route: None,
             slack_nodes: None,
+            warm_start: None,
         })
     }
 }

@@ -13,10 +13,11 @@
 //! LP infeasible: the design is then [`Termination::Infeasible`], its
 //! warnings naming the slack nodes.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use super::conic::{infeasible_design, Class, Cone, ConicProgram};
-use super::ipm::{self, IpmError, IpmSettings};
+use super::ipm::{self, IpmError, IpmSettings, WarmStart};
 use super::plan::{CompletionError, PlanReduction};
 use super::{Design, Route, Termination, UniformityError, UniformityProblem, UniformitySolver};
 
@@ -41,12 +42,37 @@ impl UniformitySolver for Lp {
     /// the geometry (measured: the pull moves linearly with the boundary from
     /// 1e-8 to 1e-4 m, `tests/design.rs`; the outer loop converges in the
     /// same iterations as with the most-uniform selection on every shipped
-    /// scene, and super-60m's loop takes 7 s instead of 61 s).
+    /// scene, and super-60m's loop takes 7 s instead of 61 s). A solve from
+    /// a neighbouring design ([`UniformitySolver::solve_from`]) follows the
+    /// central path from the neighbour's iterate at a gap of 1e-4, where
+    /// the two LPs' paths are micrometres apart, to the same face.
     fn unique_design(&self) -> bool {
         true
     }
 
     fn solve(&self, problem: &UniformityProblem) -> Result<Design, UniformityError> {
+        self.solve_warm(problem, None)
+    }
+
+    /// Starts the plan interior point from `start`'s kept iterate (the
+    /// previous outer iteration's LP, see [`WarmStart`]) when it has one.
+    fn solve_from(
+        &self,
+        problem: &UniformityProblem,
+        start: &Design,
+    ) -> Result<Design, UniformityError> {
+        self.solve_warm(problem, start.warm_start.as_deref())
+    }
+}
+
+impl Lp {
+    /// [`UniformitySolver::solve`], the plan interior point from `warm`
+    /// when given.
+    fn solve_warm(
+        &self,
+        problem: &UniformityProblem,
+        warm: Option<&WarmStart>,
+    ) -> Result<Design, UniformityError> {
         let start = Instant::now();
         if problem.has_loads() {
             return Err(UniformityError::Unsupported {
@@ -67,7 +93,12 @@ impl UniformitySolver for Lp {
         let set = &problem.sets()[0];
         let lengths = problem.lengths_m();
         let mut warnings = Vec::new();
-        let (q, iterations, route) = solve_routes(problem, &mut warnings)?;
+        let Routed {
+            q,
+            iterations,
+            route,
+            kept,
+        } = solve_routes(problem, warm, &mut warnings)?;
         let Some(q) = q else {
             let mut design = infeasible_design(problem, self.name(), iterations, start, warnings)?;
             design.route = Some(route);
@@ -98,35 +129,57 @@ impl UniformitySolver for Lp {
             warnings,
         )?;
         design.route = Some(route);
+        design.warm_start = kept.map(Arc::new);
         Ok(design)
     }
 }
 
-/// The plan route when the problem is a tied net, with its fallbacks: unscaled
-/// `q` (`None`: infeasible), iterations, and the route taken; every fallback
-/// leaves its reason in `warnings`.
+/// What the routes found: unscaled `q` (`None`: infeasible), iterations,
+/// the route taken, and the plan interior point's kept iterate.
+struct Routed {
+    q: Option<Vec<f64>>,
+    iterations: usize,
+    route: Route,
+    kept: Option<WarmStart>,
+}
+
+/// The plan route when the problem is a tied net (its interior point from
+/// `warm` when given), with its fallbacks; every fallback leaves its reason
+/// in `warnings`.
 fn solve_routes(
     problem: &UniformityProblem,
+    warm: Option<&WarmStart>,
     warnings: &mut Vec<String>,
-) -> Result<(Option<Vec<f64>>, usize, Route), UniformityError> {
+) -> Result<Routed, UniformityError> {
+    let routed = |(q, iterations), route| Routed {
+        q,
+        iterations,
+        route,
+        kept: None,
+    };
     let plan = match PlanReduction::new(problem) {
         Ok(plan) => plan,
         Err(reason) => {
             warnings.push(format!(
                 "lp: not a tied net's plan problem ({reason}); solved the full 3-D LP"
             ));
-            let (q, iterations) = solve_full(problem, warnings)?;
-            return Ok((q, iterations, Route::FullClarabel));
+            return Ok(routed(solve_full(problem, warnings)?, Route::FullClarabel));
         }
     };
-    let fallback = match solve_plan(&plan, problem, warnings) {
-        Ok((q, iterations)) => return Ok((Some(q), iterations, Route::PlanInteriorPoint)),
+    let fallback = match solve_plan(&plan, problem, warm, warnings) {
+        Ok((q, iterations, kept)) => {
+            return Ok(Routed {
+                q: Some(q),
+                iterations,
+                route: Route::PlanInteriorPoint,
+                kept,
+            })
+        }
         Err(fallback) => fallback,
     };
     if let PlanFallback::Completion(reason) = fallback {
         warnings.push(format!("lp: {reason}; solved the full 3-D LP"));
-        let (q, iterations) = solve_full(problem, warnings)?;
-        return Ok((q, iterations, Route::FullClarabel));
+        return Ok(routed(solve_full(problem, warnings)?, Route::FullClarabel));
     }
     warnings.push(format!(
         "lp: {fallback}; solved the plan LP with clarabel (QDLDL)"
@@ -134,14 +187,14 @@ fn solve_routes(
     let (q_net, iterations) = match solve_plan_clarabel(&plan, warnings)? {
         (Some(q), iterations) => (q, iterations),
         // The plan LP relaxes the full one: the full LP is infeasible too.
-        (None, iterations) => return Ok((None, iterations, Route::PlanClarabel)),
+        (None, iterations) => return Ok(routed((None, iterations), Route::PlanClarabel)),
     };
     match plan.complete(problem, &q_net) {
-        Ok(q) => Ok((Some(q), iterations, Route::PlanClarabel)),
+        Ok(q) => Ok(routed((Some(q), iterations), Route::PlanClarabel)),
         Err(reason) => {
             warnings.push(format!("lp: {reason}; solved the full 3-D LP"));
             let (q, more) = solve_full(problem, warnings)?;
-            Ok((q, iterations + more, Route::FullClarabel))
+            Ok(routed((q, iterations + more), Route::FullClarabel))
         }
     }
 }
@@ -171,14 +224,29 @@ enum PlanFallback {
     Completion(#[from] CompletionError),
 }
 
-/// The plan problem (interior point, `plan.rs`), completed with the ties and
-/// the rear net: unscaled `q` and iterations.
+/// The plan problem (interior point, `plan.rs`, from `warm` when given),
+/// completed with the ties and the rear net: unscaled `q`, iterations, and
+/// the iterate kept for the next neighbouring LP. A warm start that does not
+/// converge (stalled included) is said in `warnings` and the LP solved again
+/// from its own start.
 fn solve_plan(
     plan: &PlanReduction,
     problem: &UniformityProblem,
+    warm: Option<&WarmStart>,
     warnings: &mut Vec<String>,
-) -> Result<(Vec<f64>, usize), PlanFallback> {
-    let solution = ipm::solve(plan.lp(), &IpmSettings::plan())?;
+) -> Result<(Vec<f64>, usize, Option<WarmStart>), PlanFallback> {
+    let settings = IpmSettings::plan();
+    let mut solution = ipm::solve(plan.lp(), &settings, warm)?;
+    if warm.is_some() && solution.termination != Termination::Converged {
+        warnings.push(format!(
+            "lp: the plan interior point from the neighbouring design's iterate stopped with \
+             {:?} after {} iterations; solved again from its own start",
+            solution.termination, solution.iterations
+        ));
+        let more = solution.iterations;
+        solution = ipm::solve(plan.lp(), &settings, None)?;
+        solution.iterations += more;
+    }
     let [primal, dual, gap] = solution.residuals;
     match solution.termination {
         Termination::Converged => {}
@@ -193,7 +261,8 @@ fn solve_plan(
             })
         }
     }
-    Ok((plan.complete(problem, &solution.q)?, solution.iterations))
+    let q = plan.complete(problem, &solution.q)?;
+    Ok((q, solution.iterations, solution.kept))
 }
 
 /// The plan LP of `plan` as one conic program (clarabel, QDLDL first): two
@@ -308,7 +377,7 @@ mod tests {
             plan.has_rear(),
             "the scene's rear net mirrors its front net"
         );
-        let (q_plan, _) = solve_plan(&plan, &problem, &mut Vec::new()).expect("plan");
+        let (q_plan, _, _) = solve_plan(&plan, &problem, None, &mut Vec::new()).expect("plan");
         let q_full = solve_full(&problem, &mut Vec::new())
             .expect("full")
             .0

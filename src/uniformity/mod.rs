@@ -30,6 +30,7 @@ pub use front::{
     design_front, design_front_chains, front_chains, front_jobs, knob_values, FrontPoint, KnobRange,
 };
 pub use gradient::{FinishSettings, Gradient, History};
+pub use ipm::WarmStart;
 pub use least_squares::LeastSquares;
 pub use lp::Lp;
 pub use problem::{SurfaceTarget, UniformityProblem, UniformitySet};

@@ -29,6 +29,12 @@ pub(crate) struct Outcome<E> {
     pub measures: Measures,
     /// The failure behind a `NumericalError`, when the system reported one.
     pub error: Option<E>,
+    /// The last iterate whose gap was at least
+    /// [`IpmSettings::keep_at_gap`]: near the central path at that gap (not
+    /// closer to the optimal face, from which a neighbouring problem's
+    /// iterates could not follow their own path), the start of a
+    /// neighbouring problem.
+    pub kept: Option<Point>,
 }
 
 /// The best iterate so far, by its largest measure relative to its
@@ -73,6 +79,7 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
                 termination: Termination::NumericalError,
                 measures: Measures::NAN,
                 error: Some(error),
+                kept: None,
             }
         }
     };
@@ -110,12 +117,16 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
     let mut failed = false;
     let mut error = None;
     let mut iterations = 0;
+    let mut kept = None;
     for iteration in 0..=settings.max_iterations {
         iterations = iteration;
         measures = system.residuals(&point);
         if !measures.is_finite() {
             failed = true;
             break;
+        }
+        if settings.keep_at_gap.is_some_and(|g| measures.gap >= g) {
+            kept = Some(point.clone());
         }
         let converged = measures.primal <= pt && measures.dual <= dt && measures.gap <= gt;
         let score = (measures.primal / pt)
@@ -241,6 +252,7 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
             },
             measures: best.measures,
             error,
+            kept,
         },
         None => Outcome {
             point: Some(point),
@@ -252,6 +264,7 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
             },
             measures,
             error,
+            kept,
         },
     }
 }

@@ -72,6 +72,7 @@ pub(crate) use driver::run;
 pub(crate) use error::IpmError;
 pub(crate) use ratio::solve;
 pub(crate) use settings::IpmSettings;
+pub use status::WarmStart;
 pub(crate) use system::{Measures, NewtonSystem, Point, Rhs};
 
 #[cfg(test)]

@@ -9,15 +9,16 @@ use super::driver;
 use super::error::{IpmError, NormalError};
 use super::normal::NormalMatrix;
 use super::settings::{IpmSettings, Start};
-use super::status::IpmSolution;
+use super::status::{IpmSolution, WarmStart};
 use super::system::{Measures, NewtonSystem, Point, Rhs};
 use crate::algebra::{dot, norm_inf};
 use crate::fdm::NONE;
 use crate::status::Termination;
 
 /// Solves the ratio LP with the structured interior-point method and
-/// `settings`. The returned `q` is unscaled (smallest set tension ≈ 1); the
-/// caller rescales it.
+/// `settings`, from `start` when it is an iterate of an LP of the same sizes
+/// (else from Mehrotra's point). The returned `q` is unscaled (smallest set
+/// tension ≈ 1); the caller rescales it.
 ///
 /// # Errors
 /// A setting out of range, an LP the method does not take (a tension floor
@@ -29,6 +30,7 @@ use crate::status::Termination;
 pub(crate) fn solve<const D: usize>(
     lp: &RatioLp<D>,
     settings: &IpmSettings,
+    start: Option<&WarmStart>,
 ) -> Result<IpmSolution, IpmError> {
     settings.validate()?;
     let program = Program::new(lp, *settings)?;
@@ -48,6 +50,7 @@ pub(crate) fn solve<const D: usize>(
         rs: 0.0,
         scaling: None,
         corrector_residual: 0.0,
+        warm: start.map(|w| w.0.clone()),
     };
     let outcome = driver::run(&mut system, settings);
     let Some(point) = outcome.point else {
@@ -56,6 +59,7 @@ pub(crate) fn solve<const D: usize>(
             iterations: 0,
             termination: Termination::NumericalError,
             residuals: [f64::NAN; 3],
+            kept: None,
         });
     };
     let measures = outcome.measures;
@@ -74,6 +78,7 @@ pub(crate) fn solve<const D: usize>(
             iterations: outcome.iterations,
             termination: outcome.termination,
             residuals,
+            kept: outcome.kept.map(WarmStart),
         });
     }
     let (q, primal) = program.polish(&mut system.normal, q);
@@ -86,6 +91,7 @@ pub(crate) fn solve<const D: usize>(
             outcome.termination
         },
         residuals: [primal, measures.dual, measures.gap],
+        kept: outcome.kept.map(WarmStart),
     })
 }
 
@@ -153,6 +159,8 @@ struct LpSystem<'a, const D: usize> {
     /// The 2-norm of the last corrector's residual in the rows FGMRES
     /// completes: the tolerance of the centrality corrections that follow.
     corrector_residual: f64,
+    /// A neighbouring LP's kept iterate to start from.
+    warm: Option<Point>,
 }
 
 /// The LP's parts of a point: `(x, w | z, λ)`, the ratio `s` and `y`.
@@ -187,14 +195,27 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
         vec![self.program.m, self.program.m + self.program.set.len()]
     }
 
-    /// Mehrotra's starting point: least-norm primal point with `Θ = I`,
-    /// `Ω = I`, then shifted into the interior together with the dual; with
-    /// `Start::TensionScaled` all of it in tensions above the floor (`ℓ x`,
-    /// `z/ℓ`): least norm with `Θ = diag(1/ℓ²)`, one shift for every
-    /// tension.
+    /// A neighbouring LP's kept iterate when its sizes match and its pairs
+    /// are interior (the new LP's residuals are then those of the geometry's
+    /// change); else Mehrotra's starting point: least-norm primal point with
+    /// `Θ = I`, `Ω = I`, then shifted into the interior together with the
+    /// dual; with `Start::TensionScaled` all of it in tensions above the
+    /// floor (`ℓ x`, `z/ℓ`): least norm with `Θ = diag(1/ℓ²)`, one shift for
+    /// every tension.
     fn start(&mut self) -> Result<Point, NormalError> {
         let program = self.program;
         let (m, p, n) = (program.m, program.set.len(), self.normal.n_rows);
+        if let Some(warm) = self.warm.take() {
+            let interior = |v: &[f64]| v.len() == m + p && v.iter().all(|&v| v > 0.0);
+            if interior(&warm.primal)
+                && interior(&warm.dual)
+                && warm.free_primal.len() == 1
+                && warm.free_dual.len() == n
+                && warm.is_finite()
+            {
+                return Ok(warm);
+            }
+        }
         let lengths = &program.lengths;
         let tension_scaled = program.settings.start == Start::TensionScaled;
         let theta0: Vec<f64> = if tension_scaled {

@@ -49,7 +49,7 @@ fn full_lp(problem: &UniformityProblem) -> RatioLp<3> {
 /// optimum, balances the geometry, and keeps the bounds it was given.
 fn matches_clarabel(path: &str) {
     let problem = problem(path);
-    let solution = solve(&full_lp(&problem), &IpmSettings::default()).expect("ipm");
+    let solution = solve(&full_lp(&problem), &IpmSettings::default(), None).expect("ipm");
     assert_eq!(solution.termination, Termination::Converged);
     let lengths = problem.lengths_m();
     let set = &problem.sets()[0].edges;
@@ -122,7 +122,7 @@ fn settings_out_of_range_are_named() {
             "stall_iterations",
         ),
     ] {
-        match solve(&full_lp(&problem), &settings) {
+        match solve(&full_lp(&problem), &settings, None) {
             Err(IpmError::Setting { name: found, .. }) => assert_eq!(found, name),
             other => panic!("{name}: expected a setting error, got {other:?}"),
         }
@@ -146,7 +146,7 @@ fn lp_ratio<const D: usize>(lp: &RatioLp<D>, q: &[f64]) -> f64 {
 fn centrality_correctors_reach_the_same_plan_optimum() {
     let problem = problem("problems/paper-26m.toml");
     let plan = crate::uniformity::plan::PlanReduction::new(&problem).expect("a reflector mesh");
-    let reference = solve(plan.lp(), &IpmSettings::plan()).expect("plan");
+    let reference = solve(plan.lp(), &IpmSettings::plan(), None).expect("plan");
     assert_eq!(reference.termination, Termination::Converged);
     let reference_ratio = lp_ratio(plan.lp(), &reference.q);
     for correctors in 1..=3 {
@@ -154,7 +154,7 @@ fn centrality_correctors_reach_the_same_plan_optimum() {
             centrality_correctors: correctors,
             ..IpmSettings::plan()
         };
-        let solution = solve(plan.lp(), &settings).expect("plan");
+        let solution = solve(plan.lp(), &settings, None).expect("plan");
         assert_eq!(solution.termination, Termination::Converged, "{correctors}");
         let ratio = lp_ratio(plan.lp(), &solution.q);
         assert!(
