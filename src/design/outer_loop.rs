@@ -108,9 +108,6 @@ pub struct LoopOutcome {
     /// The design of iteration 0, for the undeformed attachment points: the
     /// conventional (rigid-truss) design.
     pub initial: TiedDesign,
-    /// The truss's equilibrium under iteration 0's pull, when its model has
-    /// a frame state: the start of the conventional design's assembly.
-    pub initial_truss_equilibrium: Option<TrussEquilibrium>,
     /// Whether the loop's truss deforms ([`TrussOracle::deforms`]): its design
     /// is then verified on the flexible truss.
     pub truss_deforms: bool,
@@ -188,7 +185,6 @@ pub fn design_loop_with(
     let mut x = flatten(oracle.attachments());
     let mut history: Vec<IterationRecord> = Vec::new();
     let mut initial: Option<TiedDesign> = None;
-    let mut initial_truss_equilibrium = None;
     // The last boundary's design: each design starts from it, so that an
     // iterative solver's answer moves smoothly with the boundary.
     let mut previous: Option<TiedDesign> = None;
@@ -213,9 +209,6 @@ pub fn design_loop_with(
         let response = oracle
             .respond(&pull)
             .map_err(|source| DesignError::Truss { iteration, source })?;
-        if iteration == 0 {
-            initial_truss_equilibrium = oracle.equilibrium();
-        }
         let image = flatten(&response.positions_m);
         let residual: Vec<f64> = image.iter().zip(&x).map(|(g, c)| g - c).collect();
         let distances: Vec<f64> = residual
@@ -249,7 +242,6 @@ pub fn design_loop_with(
                 design: tied.design,
                 problem: tied.problem,
                 initial,
-                initial_truss_equilibrium,
                 truss_deforms: oracle.deforms(),
                 boundary_m: unflatten(&x),
                 deformed_m: response.positions_m,

@@ -394,9 +394,9 @@ pub fn run_observed(
     observer.stage(DesignStage::Conventional);
     let stage = Instant::now();
     // The conventional design is the loop's iteration 0: the design for the
-    // undeformed attachment points, assembled from the truss's response to
-    // it that the loop already solved, on the design's analysis of the
-    // assembly (the same network and truss, other cut lengths).
+    // undeformed attachment points, assembled from the undeformed truss on
+    // the design's analysis of the assembly (the same network and truss,
+    // other cut lengths).
     let conventional_assembly = match frame {
         None => None,
         Some(frame) => {
@@ -409,14 +409,11 @@ pub fn run_observed(
                 design: &outcome.initial.design,
                 frame: Some(frame),
             };
-            let start = match &outcome.initial_truss_equilibrium {
-                Some(truss) => AssemblyStart::Beside {
-                    truss,
-                    beside: &assembled,
-                },
-                None => AssemblyStart::Unknown,
-            };
-            let conventional = assemble(&inputs, start, &Perturbation::none())?;
+            let conventional = assemble(
+                &inputs,
+                AssemblyStart::Beside(&assembled),
+                &Perturbation::none(),
+            )?;
             Some((network.clone(), conventional))
         }
     };

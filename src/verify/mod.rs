@@ -420,26 +420,27 @@ pub enum AssemblyStart<'a> {
     /// ([`StaticSolver::with_model`]), and where Newton does not converge
     /// at once the cut lengths are ramped from its own.
     Assembly(&'a Assembled),
-    /// Another design on the same network and truss (the conventional one
-    /// beside the flexible): Newton starts from `truss`, this design's own
-    /// truss equilibrium, as from [`AssemblyStart::Truss`], and `beside`'s
-    /// analysis is shared. (On super-60m the flexible design's assembled
-    /// state was the worse start for the conventional one: 4 + 19 Newton
-    /// iterations against 4 + 7 from its own truss equilibrium.)
-    Beside {
-        /// This design's truss equilibrium.
-        truss: &'a TrussEquilibrium,
-        /// The other design's assembly.
-        beside: &'a Assembled,
-    },
+    /// The assembly of another design on the same network and truss, for a
+    /// design whose net balances the *undeformed* truss (the conventional
+    /// one beside the flexible): its analysis is shared, and Newton starts
+    /// from the undeformed truss, where this net is in balance with its cut
+    /// lengths, the prestrain ramped as from [`AssemblyStart::Unknown`].
+    /// Measured against the two other starts: this design's own truss
+    /// equilibrium under its pull (the deformed truss with the net where it
+    /// was designed, out of balance by the boundary's motion) took 4 Newton
+    /// iterations that did not converge on super-60m and super-100m before
+    /// this path's 7 and 4, and converged in 4 where this path takes 2 on
+    /// paper-26m and target-40m (super-100m's conventional stage 10.5 →
+    /// 5.2 s); the other design's assembled state took 4 + 19 on super-60m.
+    Beside(&'a Assembled),
 }
 
 /// Assemble `inputs`' design, as built with `perturbation`, and solve from
 /// `start`.
 ///
 /// From a truss equilibrium, Newton takes [`GUESS_ITERATIONS`]; if that
-/// fails, the prestrain is ramped from the undeformed truss in load steps.
-/// From the same design's assembly, Newton takes as many; then the cut
+/// fails, the prestrain is ramped from the undeformed truss in load steps
+/// (beside another design's assembly, at once). From the same design's assembly, Newton takes as many; then the cut
 /// lengths are ramped from the assembly's, in at most
 /// [`PERTURBED_MAX_STEPS`] load steps, and the assembly fails if that
 /// fails (the ramp from the undeformed truss would repeat the design's
@@ -494,7 +495,7 @@ pub fn assemble(
     // The analysis of the structure: shared with another assembly's where
     // the start comes with one.
     let shared = match start {
-        AssemblyStart::Assembly(a) | AssemblyStart::Beside { beside: a, .. } => Some(&a.solver),
+        AssemblyStart::Assembly(a) | AssemblyStart::Beside(a) => Some(&a.solver),
         AssemblyStart::Unknown | AssemblyStart::Truss(_) => None,
     };
     let solver_of = |b: ModelBuilder| -> Result<StaticSolver, VerifyError> {
@@ -529,16 +530,15 @@ pub fn assemble(
             found = Some((solver, s));
         }
     } else {
-        // First from the truss as the design's pull deforms it (the
-        // equilibrium sought is near: Newton from the undeformed truss can
-        // diverge, the hinge motion being many times the cables' elastic
-        // stretch); then, if that fails, from the undeformed truss with the
-        // prestrain ramped in load steps.
+        // For a net designed on the deformed truss, first from the truss as
+        // the design's pull deforms it (the equilibrium sought is near:
+        // Newton from the undeformed truss can diverge, the hinge motion
+        // being many times the cables' elastic stretch); then, if that
+        // fails, from the undeformed truss with the prestrain ramped in load
+        // steps — at once for a net designed on the undeformed truss.
         let guess = match (frame, start) {
-            (None, _) => None,
-            (Some(_), AssemblyStart::Truss(e) | AssemblyStart::Beside { truss: e, .. }) => {
-                Some(Cow::Borrowed(e))
-            }
+            (None, _) | (_, AssemblyStart::Beside(_)) => None,
+            (Some(_), AssemblyStart::Truss(e)) => Some(Cow::Borrowed(e)),
             (Some(frame), _) => truss_guess(frame, &mesh.truss, design)?.map(Cow::Owned),
         };
         if let Some(guess) = &guess {
