@@ -114,27 +114,51 @@ fn from_vector(x: &[f64; 6]) -> PlacedParaboloid {
 
 /// Mean square half-path-length error of `samples` about `x`.
 fn mean_square(x: &[f64; 6], samples: &Samples) -> f64 {
-    let placed = from_vector(x);
+    let deviation = from_vector(x).deviations();
     let (mut sum, mut weight) = (0.0, 0.0);
     samples.for_each(|p, w| {
-        let e = placed.deviation(p).half_path_m;
+        let e = deviation(p).half_path_m;
         sum += w * e * e;
         weight += w;
     });
     sum / weight
 }
 
-/// The half-path-length error of point `p_m` about `x` and its gradient in
-/// the six parameters.
+/// The rotation of parameters `x` and the sines and cosines of its two
+/// angles: formed once per Gauss–Newton iteration, not per point.
+#[derive(Clone, Copy)]
+struct Tilt {
+    r: [[f64; 3]; 3],
+    sx: f64,
+    cx: f64,
+    sy: f64,
+    cy: f64,
+}
+
+impl Tilt {
+    fn of(x: &[f64; 6]) -> Tilt {
+        let (sx, cx) = x[3].sin_cos();
+        let (sy, cy) = x[4].sin_cos();
+        Tilt {
+            r: from_vector(x).rotation(),
+            sx,
+            cx,
+            sy,
+            cy,
+        }
+    }
+}
+
+/// The half-path-length error of point `p_m` about `x` (with its `tilt`)
+/// and its gradient in the six parameters.
 ///
 /// With `q = Rᵀ(p − a)`, `s = q_x² + q_y²`, `δ = q_z − s/(4F)` and
 /// `w = 4F²/(4F² + s)`, the error is `g = w δ`:
 /// `∇_q g = w (−q_x/(2F), −q_y/(2F), 1) − δ w²/(4F²) (2q_x, 2q_y, 0)`,
 /// `∂g/∂F = w s/(4F²) + δ w² 2s/(4F³)`, `∂g/∂a = −R ∇_q g`, and
 /// `∂g/∂θ = ∇_q g · ∂q/∂θ` through `Rᵀ = R_yᵀ R_xᵀ`.
-fn residual_and_gradient(x: &[f64; 6], p_m: [f64; 3]) -> (f64, [f64; 6]) {
-    let placed = from_vector(x);
-    let r = placed.rotation();
+fn residual_and_gradient(x: &[f64; 6], tilt: &Tilt, p_m: [f64; 3]) -> (f64, [f64; 6]) {
+    let Tilt { r, sx, cx, sy, cy } = *tilt;
     let d: [f64; 3] = std::array::from_fn(|k| p_m[k] - x[k]);
     let q: [f64; 3] = std::array::from_fn(|i| r[0][i] * d[0] + r[1][i] * d[1] + r[2][i] * d[2]);
     let f = x[5];
@@ -150,8 +174,6 @@ fn residual_and_gradient(x: &[f64; 6], p_m: [f64; 3]) -> (f64, [f64; 6]) {
     ];
     let dg_df = w * s / (4.0 * f * f) + delta * w * w * 2.0 * s / (4.0 * f * f * f);
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let (sx, cx) = x[3].sin_cos();
-    let (sy, cy) = x[4].sin_cos();
     // ∂q/∂θx = R_yᵀ (∂R_x/∂θx)ᵀ d, (∂R_x/∂θx)ᵀ = [0 0 0; 0 −sx cx; 0 −cx −sx].
     let u = [0.0, -sx * d[1] + cx * d[2], -cx * d[1] - sx * d[2]];
     let dq_dx = [cy * u[0] - sy * u[2], u[1], sy * u[0] + cy * u[2]];
@@ -230,8 +252,9 @@ fn fit(paraboloid: &Paraboloid, samples: &Samples) -> Result<BestFit, SurfaceErr
         }
         // Normal equations of the weighted least squares, per unit weight.
         let (mut lower, mut b, mut weight) = ([[0.0; 6]; 6], [0.0; 6], 0.0);
+        let tilt = Tilt::of(&x);
         samples.for_each(|p, w| {
-            let (g, grad) = residual_and_gradient(&x, p);
+            let (g, grad) = residual_and_gradient(&x, &tilt, p);
             weight += w;
             for i in 0..6 {
                 b[i] -= w * g * grad[i];
@@ -310,12 +333,13 @@ mod tests {
         let x = [0.02, -0.01, 0.03, 0.004, -0.006, 6.1];
         let h = 1e-6;
         for p in some_points().into_iter().step_by(7) {
-            let (_, grad) = residual_and_gradient(&x, p);
+            let (_, grad) = residual_and_gradient(&x, &Tilt::of(&x), p);
             for k in 0..6 {
                 let (mut up, mut down) = (x, x);
                 up[k] += h;
                 down[k] -= h;
-                let fd = (residual_and_gradient(&up, p).0 - residual_and_gradient(&down, p).0)
+                let fd = (residual_and_gradient(&up, &Tilt::of(&up), p).0
+                    - residual_and_gradient(&down, &Tilt::of(&down), p).0)
                     / (2.0 * h);
                 // Central differences: O(h²) truncation, O(ε|g|/h) rounding.
                 assert!(

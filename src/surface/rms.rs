@@ -56,8 +56,9 @@ pub(crate) fn check_paraboloid(paraboloid: &Paraboloid) -> Result<(), SurfaceErr
 /// The weighted RMS of the deviations of `samples` from `placed`.
 pub(crate) fn rms_about(placed: &PlacedParaboloid, samples: &Samples) -> SurfaceRms {
     let (mut weight, mut axial, mut normal, mut half_path) = (0.0, 0.0, 0.0, 0.0);
+    let deviation = placed.deviations();
     samples.for_each(|p, w| {
-        let d = placed.deviation(p);
+        let d = deviation(p);
         weight += w;
         axial += w * d.axial_m * d.axial_m;
         normal += w * d.normal_m * d.normal_m;
