@@ -406,8 +406,8 @@ fn a_plan_lp_from_the_neighbouring_boundarys_iterate_reaches_the_cold_optimum() 
                  pull change {pull_change:.3e} N, warm − cold {pull_gap:.3e} N; warnings {:?}",
                 warm.iterations, cold.iterations, warm.ratio, cold.ratio, warm.warnings
             );
-            // Measured: 3–4 iterations against 7–10, ratios within 3e-12,
-            // pulls within 7.2e-5 of the boundary's effect.
+            // Measured: 2–3 iterations against 7–10, ratios within 1.4e-12,
+            // pulls within 4.2e-5 of the boundary's effect.
             assert!(warm.warnings.is_empty(), "{context}");
             assert!(2 * warm.iterations <= cold.iterations, "{context}");
             assert!((warm.ratio / cold.ratio - 1.0).abs() <= 1e-9, "{context}");

@@ -44,7 +44,7 @@ impl UniformitySolver for Lp {
     /// same iterations as with the most-uniform selection on every shipped
     /// scene, and super-60m's loop takes 7 s instead of 61 s). A solve from
     /// a neighbouring design ([`UniformitySolver::solve_from`]) follows the
-    /// central path from the neighbour's iterate at a gap of 1e-4, where
+    /// central path from the neighbour's iterate at a gap of 1e-5, where
     /// the two LPs' paths are micrometres apart, to the same face.
     fn unique_design(&self) -> bool {
         true

@@ -199,22 +199,25 @@ impl IpmSettings {
     /// run ended in `MaxIterations` and the route fell back to clarabel,
     /// which needs minutes at that size).
     ///
-    /// It keeps its last iterate with a relative gap of at least 1e-4 for
-    /// the next outer iteration's LP, whose boundary differs by micrometres:
-    /// measured on super-60m's design loop, the three later LPs took 13, 12
-    /// and 11 iterations from it against 25, 25 and 26 cold, converged at the
-    /// same residuals. (The first iterate below 1e-4 took 13, 9 and 10, but
-    /// on small-hex that is already the optimum, gap 3e-9: the next LP then
-    /// barely moves along its own path, and the outer loop to a 1e-7 m
-    /// tolerance took 13 iterations with Anderson mixing and 11 with the
-    /// paper's relaxation, against 4 and 6 cold and with this rule.)
+    /// It keeps its last iterate with a relative gap of at least 1e-5 for
+    /// the next outer iteration's LP, whose boundary differs by micrometres.
+    /// Measured on super-60m's design loop (LPs of 42 840 cables), the
+    /// uniformity stage and the final ratio: cold 6.95 s (the three later
+    /// LPs 25, 25 and 26 iterations), 15.8668529; kept at 1e-4 5.26 s (13,
+    /// 12 and 11), 15.8668970; at 1e-5 4.41 s (the last LP 10), 15.8668471;
+    /// at 1e-6 4.01 s, 15.8669741 — the closer to the optimal face the start,
+    /// the less the next LP follows its own central path. (The *first*
+    /// iterate below 1e-4 is already the optimum on small-hex, gap 3e-9:
+    /// the outer loop to a 1e-7 m tolerance then took 13 iterations with
+    /// Anderson mixing and 11 with the paper's relaxation, against 4 and 6
+    /// cold and with this rule.)
     pub(crate) fn plan() -> Self {
         IpmSettings {
             regularization: 1e-12,
             pivot_epsilon: 1e-30,
             start: Start::TensionScaled,
             max_iterations: 200,
-            keep_at_gap: Some(1e-4),
+            keep_at_gap: Some(1e-5),
             ..IpmSettings::default()
         }
     }
