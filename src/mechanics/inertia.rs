@@ -292,7 +292,9 @@ impl InertiaStructure {
         let k =
             SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, &gathered).ok()?;
         let n = k.nrows();
-        let par = faer::get_global_parallelism();
+        // One thread, as the frame's LU (`sparse_lu.rs`): a truss's
+        // supernodes are small (realistic-26m's limit margin 2.01 → 1.86 s).
+        let par = faer::Par::Seq;
         let mut l = vec![0.0; self.cholesky.len_val()];
         let mut subdiag = vec![0.0; n];
         let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);

@@ -22,6 +22,16 @@ use faer::sparse::linalg::{LuError, SupernodalThreshold};
 use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
+/// The parallelism of the factorisation and its solves: one thread. A
+/// frame's supernodes are small (rods of a few elements, joints, the
+/// attachment block), and faer's parallel kernels spent their time waiting
+/// on each other: measured on whole designs, two threads against one,
+/// the limit margin (a few hundred LUs of the truss) took 4.19 → 1.99 s on
+/// realistic-26m, 3.85 → 1.89 s on paper-26m, 2.22 → 1.33 s on super-100m,
+/// and super-100m's conventional assembly 5.88 → 5.06 s (its condensed
+/// frame's LU).
+const PARALLELISM: Par = Par::Seq;
+
 /// The symbolic analysis of a sparse LU: column order and supernodes, once
 /// per pattern.
 #[derive(Debug, Clone)]
@@ -60,7 +70,7 @@ impl Lu {
         symbolic: SymbolicLu,
         matrix: SparseColMatRef<'_, usize, f64>,
     ) -> Result<Self, LuError> {
-        let par = faer::get_global_parallelism();
+        let par = PARALLELISM;
         let mut numeric = NumericLu::new();
         let scratch = symbolic
             .0
