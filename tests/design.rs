@@ -322,6 +322,19 @@ fn the_timings_of_a_design_run_add_up_to_its_wall_time() {
     assert_eq!(written["timings"]["total_s"].as_f64(), Some(t.total_s));
 }
 
+/// The attachment points `c0` with every top hinge (the first `bays`) moved
+/// radially inward by `h`, m.
+fn top_hinges_moved_inward(c0: &[[f64; 3]], bays: usize, h: f64) -> Vec<[f64; 3]> {
+    c0.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let r = p[0].hypot(p[1]);
+            let s = if i < bays { 1.0 - h / r } else { 1.0 };
+            [p[0] * s, p[1] * s, p[2]]
+        })
+        .collect()
+}
+
 /// The outer loop needs the net's pull to be a function of the boundary: a
 /// ratio solver's optimum is a face, and the design the loop takes from it
 /// must move with the boundary continuously — the pull's change is linear in
@@ -329,26 +342,14 @@ fn the_timings_of_a_design_run_add_up_to_its_wall_time() {
 #[test]
 fn the_pull_of_the_design_moves_linearly_with_the_boundary() {
     for name in ["small-hex", "realistic-26m"] {
-        let scene = common::scene(name);
-        let (mesh, problem) = scene_problem(&scene).unwrap();
-        let nets = TiedNets::new(&mesh, problem).unwrap();
+        let (_, mesh, nets) = common::scene_nets(name);
         let solver = SolverKind::Lp.build(None);
         let c0 = layout_points(&mesh.truss);
         let pull0 = nets.design(solver.as_ref(), &c0).unwrap().design.pull_n();
         let slopes: Vec<f64> = [1e-8, 1e-7, 1e-6, 1e-5, 1e-4]
             .iter()
             .map(|&h| {
-                // Every top hinge moves radially inward by h.
-                let n = mesh.truss.bays();
-                let moved: Vec<[f64; 3]> = c0
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| {
-                        let r = p[0].hypot(p[1]);
-                        let s = if i < n { 1.0 - h / r } else { 1.0 };
-                        [p[0] * s, p[1] * s, p[2]]
-                    })
-                    .collect();
+                let moved = top_hinges_moved_inward(&c0, mesh.truss.bays(), h);
                 let pull = nets
                     .design(solver.as_ref(), &moved)
                     .unwrap()
@@ -376,24 +377,13 @@ fn the_pull_of_the_design_moves_linearly_with_the_boundary() {
 #[test]
 fn a_plan_lp_from_the_neighbouring_boundarys_iterate_reaches_the_cold_optimum() {
     for name in ["small-hex", "realistic-26m"] {
-        let scene = common::scene(name);
-        let (mesh, problem) = scene_problem(&scene).unwrap();
-        let nets = TiedNets::new(&mesh, problem).unwrap();
+        let (_, mesh, nets) = common::scene_nets(name);
         let solver = SolverKind::Lp.build(None);
         let c0 = layout_points(&mesh.truss);
         let first = nets.design(solver.as_ref(), &c0).unwrap();
         assert!(first.front.warm_start.is_some(), "{name}: no iterate kept");
         for h in [1e-6, 1e-5, 1e-4] {
-            let n = mesh.truss.bays();
-            let moved: Vec<[f64; 3]> = c0
-                .iter()
-                .enumerate()
-                .map(|(i, p)| {
-                    let r = p[0].hypot(p[1]);
-                    let s = if i < n { 1.0 - h / r } else { 1.0 };
-                    [p[0] * s, p[1] * s, p[2]]
-                })
-                .collect();
+            let moved = top_hinges_moved_inward(&c0, mesh.truss.bays(), h);
             let cold = nets.design(solver.as_ref(), &moved).unwrap().design;
             let warm = nets
                 .design_from(solver.as_ref(), &moved, Some(&first))

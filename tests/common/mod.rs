@@ -84,9 +84,14 @@ pub fn scene(name: &str) -> Scene {
 
 /// small-hex: its scene, mesh and two-stage design problem (weightless).
 pub fn small_hex_nets() -> (Scene, ReflectorMesh, TiedNets) {
-    let scene = scene("small-hex");
-    let (mesh, problem) = scene_problem(&scene).expect("small-hex builds");
-    let nets = TiedNets::new(&mesh, problem).expect("small-hex's nets");
+    scene_nets("small-hex")
+}
+
+/// A shipped scene, its mesh and its tied nets.
+pub fn scene_nets(name: &str) -> (Scene, ReflectorMesh, TiedNets) {
+    let scene = scene(name);
+    let (mesh, problem) = scene_problem(&scene).unwrap_or_else(|e| panic!("{name} builds: {e}"));
+    let nets = TiedNets::new(&mesh, problem).unwrap_or_else(|e| panic!("{name}'s nets: {e}"));
     (scene, mesh, nets)
 }
 
