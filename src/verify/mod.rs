@@ -431,7 +431,8 @@ pub enum AssemblyStart<'a> {
     /// iterations that did not converge on super-60m and super-100m before
     /// this path's 7 and 4, and converged in 4 where this path takes 2 on
     /// paper-26m and target-40m (super-100m's conventional stage 10.5 →
-    /// 5.2 s); the other design's assembled state took 4 + 19 on super-60m.
+    /// 5.1–6.3 s); the other design's assembled state took 4 + 19 on
+    /// super-60m.
     Beside(&'a Assembled),
 }
 
@@ -440,8 +441,9 @@ pub enum AssemblyStart<'a> {
 ///
 /// From a truss equilibrium, Newton takes [`GUESS_ITERATIONS`]; if that
 /// fails, the prestrain is ramped from the undeformed truss in load steps
-/// (beside another design's assembly, at once). From the same design's assembly, Newton takes as many; then the cut
-/// lengths are ramped from the assembly's, in at most
+/// (beside another design's assembly, at once). From the same design's
+/// assembly, Newton takes as many; then the cut lengths are ramped from the
+/// assembly's, in at most
 /// [`PERTURBED_MAX_STEPS`] load steps, and the assembly fails if that
 /// fails (the ramp from the undeformed truss would repeat the design's
 /// whole assembly to find what this path could not, and took minutes for

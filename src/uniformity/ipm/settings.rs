@@ -254,12 +254,12 @@ impl IpmSettings {
         }
     }
 
-    /// Checks every setting's range: the tolerances, the pivot threshold and
-    /// the shifts and the gap of a kept iterate in `(0, 1)`, the reduced tolerances at least the ones they
-    /// relax, the shift bound at least the first shift, a growth above 1, a
-    /// positive replacement pivot, a fixed step fraction in `(0, 1)`, a
-    /// positive first slack and warm floor, and at least one stall
-    /// iteration.
+    /// Checks every setting's range: the tolerances, the pivot threshold,
+    /// the shifts and the gap of a kept iterate in `(0, 1)`, the reduced
+    /// tolerances at least the ones they relax, the shift bound at least the
+    /// first shift, a growth above 1, a positive replacement pivot, a fixed
+    /// step fraction in `(0, 1)`, a positive first slack and warm floor, and
+    /// at least one stall iteration.
     ///
     /// # Errors
     /// [`IpmError::Setting`] naming the first field out of its range.

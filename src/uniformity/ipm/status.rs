@@ -9,7 +9,7 @@ use super::system::Point;
 use crate::status::Termination;
 
 /// An interior iterate of a ratio LP kept at a moderate gap
-/// ([`super::IpmSettings::keep_at_gap`]): the start of the LP of a
+/// (`IpmSettings::keep_at_gap`, crate-private): the start of the LP of a
 /// neighbouring geometry of the same net — the outer loop's next boundary,
 /// micrometres away — which then follows its own central path from there.
 /// Opaque: only the ratio LP reads it, and only when its sizes match.
