@@ -29,7 +29,9 @@ use faer::{Conj, MatMut, Par};
 /// the limit margin (a few hundred LUs of the truss) took 4.19 → 1.99 s on
 /// realistic-26m, 3.85 → 1.89 s on paper-26m, 2.22 → 1.33 s on super-100m,
 /// and super-100m's conventional assembly 5.88 → 5.06 s (its condensed
-/// frame's LU).
+/// frame's LU). On a larger frame the two balance: super-60m with 120 bays
+/// took 56.2 s with two threads and 57.4–58.4 s with one (verification
+/// 6.7 s against 7.3–8.3 s, the margin 2.2 s against 1.5–1.8 s).
 const PARALLELISM: Par = Par::Seq;
 
 /// The symbolic analysis of a sparse LU: column order and supernodes, once
