@@ -603,7 +603,8 @@ fn a_design_ignores_the_budget_sections() {
 fn chord_iterations_through_slackening_cables_find_newtons_equilibrium() {
     // At σ = 0.3 mm the samples slacken cables: the chord iterations then
     // refactor a matrix in which slack cables keep 1 % of their stiffness
-    // (`SLACK_ITERATION_RATIO`), not the tangent. Its residual is exact, so
+    // (`SLACK_ITERATION_RATIO`), not the tangent, until the slack cables
+    // settle (`SETTLED_SLACK_CHANGE`). Its residual is exact, so
     // the equilibrium must still be Newton's from the load ramp: the same
     // positions to the solvers' tolerance and the same slack cables.
     let (scene, run) = designed();

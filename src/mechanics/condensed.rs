@@ -56,6 +56,15 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, Mat, MatMut, Par, Side};
 
+/// The parallelism of the net's LDLᵀ and its solves: one thread, as the
+/// frame's LU ([`super::sparse_lu`]). Two threads spent a third of the
+/// CPU in the scheduler (faer's supernodes waiting on each other), and
+/// were slower: super-100m's design tangent 1.52 → 0.86 s, its whole
+/// `ringmesh design` 30.9–31.9 → 28.7–29.5 s (verification and the
+/// conventional assembly); its tolerance samples, each on its own thread
+/// already, unchanged (four in 42.1 s against 42.6 s).
+const PARALLELISM: Par = Par::Seq;
+
 /// Why a condensed factor could not be computed.
 #[derive(Debug, Clone, thiserror::Error)]
 pub(crate) enum CondensedError {
@@ -253,7 +262,7 @@ impl Condensation {
             s,
             ldlt,
             lu,
-            par: faer::get_global_parallelism(),
+            par: PARALLELISM,
         }))
     }
 

@@ -174,7 +174,11 @@ impl Linearisation<'_> {
     /// where every step refactors), at most [`CHORD_REFACTORISATIONS`]
     /// times. The refactored matrix keeps [`SLACK_ITERATION_RATIO`] of a
     /// slack cable's axial stiffness: the exact tangent (1e-9 of it) throws
-    /// a node held by slack cables far across their taut kink. A step whose
+    /// a node held by slack cables far across their taut kink. Once the
+    /// slack cables have settled — at most [`SETTLED_SLACK_CHANGE`] of them
+    /// changed by the last step — the exact tangent is factored instead:
+    /// the kept stiffness, wrong by 1e-2 EA/L on every slack cable, makes
+    /// Newton's convergence linear there. A step whose
     /// residual grows is halved, at most
     /// [`LINE_SEARCH_HALVINGS`] times, and the least residual tried kept: a
     /// full step past cables going slack overshoots. (super-60m's tolerance
@@ -210,6 +214,9 @@ impl Linearisation<'_> {
         let mut refactorisations = 0;
         let mut previous = f64::INFINITY;
         let mut ev = system.evaluate_with(changed, &state, self.lambda, SLACK_ITERATION_RATIO);
+        // The slack cables of the last two iterates, and how many changed.
+        let mut slack = slack_cables(changed, &state, self.lambda);
+        let mut slack_changed = usize::MAX;
         // Whether the last step was Newton's (the tangent refactored where
         // it was taken), and whether it was taken after the force test
         // passed: after a chord step that test alone is not enough — the
@@ -237,7 +244,16 @@ impl Linearisation<'_> {
                 if refactorisations == CHORD_REFACTORISATIONS {
                     return Ok(None);
                 }
-                let Ok(factor) = system.factor(&ev.values) else {
+                let settled = slack_changed as f64
+                    <= SETTLED_SLACK_CHANGE * slack.iter().filter(|&&s| s).count() as f64;
+                let exact;
+                let values = if settled {
+                    exact = system.evaluate(changed, &state, self.lambda);
+                    &exact.values
+                } else {
+                    &ev.values
+                };
+                let Ok(factor) = system.factor(values) else {
                     return Ok(None);
                 };
                 refactorisations += 1;
@@ -273,6 +289,9 @@ impl Linearisation<'_> {
             };
             state = trial;
             ev = trial_ev;
+            let now = slack_cables(changed, &state, self.lambda);
+            slack_changed = now.iter().zip(&slack).filter(|(a, b)| a != b).count();
+            slack = now;
             newton &= fraction == 1.0;
             if fraction == 1.0 && self.solver.increment_converged(&delta, &weights, settings) {
                 return Ok(Some((state, iteration + 1)));
@@ -282,6 +301,32 @@ impl Linearisation<'_> {
         Ok(None)
     }
 }
+
+/// Whether each cable of `model` is slack at `state`.
+fn slack_cables(model: &Model, state: &State, lambda: f64) -> Vec<bool> {
+    model
+        .cables()
+        .iter()
+        .map(|c| {
+            let [a, b] = c.nodes();
+            let at = |n: usize| &state.frames[n].position_m;
+            c.state(at(a), at(b), lambda).slack
+        })
+        .collect()
+}
+
+/// The fraction of the slack cables whose change by the last step says the
+/// slack cables have settled, [`Linearisation::solve`] then factoring the
+/// exact tangent. A super-100m tolerance sample (≈ 5 800 cables ending
+/// slack) has ≈ 27 500 slack after the chord steps, then ≈ 10 600, 7 400,
+/// 6 300, 5 950, 5 780, then changes of a few cables an iteration, where
+/// the kept stiffness converged linearly (≈ 0.55 a step; one sample 23
+/// iterations and 17 refactorisations). `cargo bench --bench budget`, two
+/// threads, never (the iteration matrix throughout) / 0.01 / 0.05 / 0.1 /
+/// 0.25: four samples of super-100m 42.8 / 35.7 / 34.9 / 32.4 / 39.8 s;
+/// eight of super-60m (≈ 800 slack each) 14.7 / 14.9 / 13.6–14.0 /
+/// 13.5–13.7 / 13.3–13.4 s.
+pub const SETTLED_SLACK_CHANGE: f64 = 0.1;
 
 /// Chord steps [`Linearisation::solve`] takes past its force test, to its
 /// increment test.
