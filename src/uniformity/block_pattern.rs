@@ -37,6 +37,10 @@ pub(crate) struct BlockPattern {
     pub(crate) col_ptr: Vec<usize>,
     pub(crate) pattern: SymbolicSparseColMat<usize>,
     pub(crate) symbolic: SymbolicCholesky<usize>,
+    /// What it was made for: the cables' ends, the free nodes, the block.
+    ends: Vec<[usize; 2]>,
+    n_free: usize,
+    b: usize,
 }
 
 impl BlockPattern {
@@ -99,6 +103,16 @@ impl BlockPattern {
             col_ptr,
             pattern,
             symbolic,
+            ends: ends.to_vec(),
+            n_free,
+            b,
         })
+    }
+
+    /// Whether this is the pattern [`BlockPattern::new`] makes of `ends`,
+    /// `n_free` and `b`: a net of the same cables, ends and fixed nodes
+    /// (its geometry may differ), whose matrices it factors as they are.
+    pub(crate) fn fits(&self, ends: &[[usize; 2]], n_free: usize, b: usize) -> bool {
+        self.n_free == n_free && self.b == b && self.ends == ends
     }
 }

@@ -55,7 +55,8 @@ impl UniformitySolver for Lp {
     }
 
     /// Starts the plan interior point from `start`'s kept iterate (the
-    /// previous outer iteration's LP, see [`WarmStart`]) when it has one.
+    /// previous outer iteration's LP, see [`WarmStart`]) when it has one,
+    /// with that LP's symbolic analysis of the normal matrix.
     fn solve_from(
         &self,
         problem: &UniformityProblem,
@@ -244,7 +245,8 @@ fn solve_plan(
             solution.termination, solution.iterations
         ));
         let more = solution.iterations;
-        solution = ipm::solve(plan.lp(), &settings, None)?;
+        let analysis = warm.map(WarmStart::without_iterate);
+        solution = ipm::solve(plan.lp(), &settings, analysis.as_ref())?;
         solution.iterations += more;
     }
     let [primal, dual, gap] = solution.residuals;

@@ -7,8 +7,10 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::linalg::cholesky::LltRef;
+use std::sync::Arc;
+
+use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par, Side};
 
 use super::data::RatioLp;
@@ -34,12 +36,9 @@ pub(super) struct NormalMatrix<const D: usize> {
     ends: Vec<[usize; 2]>,
     /// Edge vectors in the `D` coordinates.
     u: Vec<[f64; D]>,
-    /// For a cable with two free ends: the index of its upper end in the lower
-    /// end's neighbour list (its off-diagonal block in that block column).
-    neighbour: Vec<usize>,
-    col_ptr: Vec<usize>,
-    pattern: SymbolicSparseColMat<usize>,
-    symbolic: SymbolicCholesky<usize>,
+    /// The pattern, its ordering and symbolic factorisation: shared with
+    /// the LPs of neighbouring geometries of the same net ([`super::WarmStart`]).
+    structure: Arc<BlockPattern>,
     /// Values of `M`, scaled to unit diagonal.
     values: Vec<f64>,
     /// `1/√M_ii`.
@@ -54,7 +53,14 @@ pub(super) struct NormalMatrix<const D: usize> {
 }
 
 impl<const D: usize> NormalMatrix<D> {
-    pub(super) fn new(lp: &RatioLp<D>, settings: &IpmSettings) -> Result<Self, NormalError> {
+    /// The normal matrix of `lp`, its symbolic analysis `reuse`d where that
+    /// was made for the same net ([`BlockPattern::fits`]): the LP of a
+    /// neighbouring geometry refactors numerically only.
+    pub(super) fn new(
+        lp: &RatioLp<D>,
+        settings: &IpmSettings,
+        reuse: Option<&Arc<BlockPattern>>,
+    ) -> Result<Self, NormalError> {
         let n_free = lp.n_free;
         let n_rows = D * n_free;
         let u = lp.vectors.clone();
@@ -64,12 +70,11 @@ impl<const D: usize> NormalMatrix<D> {
             .map(|e| e.map(|i| i.unwrap_or(NONE)))
             .collect();
 
-        let BlockPattern {
-            neighbour,
-            col_ptr,
-            pattern,
-            symbolic,
-        } = BlockPattern::new(&ends, n_free, D)?;
+        let structure = match reuse {
+            Some(shared) if shared.fits(&ends, n_free, D) => Arc::clone(shared),
+            _ => Arc::new(BlockPattern::new(&ends, n_free, D)?),
+        };
+        let symbolic = &structure.symbolic;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(PAR, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, PAR),
@@ -77,22 +82,24 @@ impl<const D: usize> NormalMatrix<D> {
         let buffer =
             MemBuffer::try_new(req).map_err(|_| NormalError::OutOfMemory("the factorisation"))?;
         let factor = vec![0.0; symbolic.len_val()];
-        let supernodes = Supernodes::of(&symbolic);
+        let supernodes = Supernodes::of(symbolic);
         Ok(NormalMatrix {
             n_rows,
             ends,
             u,
-            neighbour,
-            values: vec![0.0; col_ptr[n_rows]],
-            col_ptr,
-            pattern,
-            symbolic,
+            values: vec![0.0; structure.col_ptr[n_rows]],
+            structure,
             scale: vec![1.0; n_rows],
             factor,
             supernodes,
             buffer,
             settings: *settings,
         })
+    }
+
+    /// The pattern and its analysis, for a neighbouring LP.
+    pub(super) fn pattern(&self) -> Arc<BlockPattern> {
+        Arc::clone(&self.structure)
     }
 
     /// `out = A v` (n_rows).
@@ -132,7 +139,7 @@ impl<const D: usize> NormalMatrix<D> {
     pub(super) fn factorize(&mut self, theta: &[f64]) -> Result<(), NormalError> {
         let values = &mut self.values;
         values.fill(0.0);
-        let col_ptr = &self.col_ptr;
+        let col_ptr = &self.structure.col_ptr;
         for (k, (&[a, b], uk)) in self.ends.iter().zip(&self.u).enumerate() {
             let t = theta[k];
             for end in [a, b] {
@@ -149,7 +156,7 @@ impl<const D: usize> NormalMatrix<D> {
             if a != NONE && b != NONE {
                 let lo = a.min(b);
                 for c in 0..D {
-                    let base = col_ptr[D * lo + c] + (D - c) + D * self.neighbour[k];
+                    let base = col_ptr[D * lo + c] + (D - c) + D * self.structure.neighbour[k];
                     let tc = t * uk[c];
                     for r in 0..D {
                         values[base + r] -= tc * uk[r];
@@ -165,7 +172,7 @@ impl<const D: usize> NormalMatrix<D> {
                 1.0
             };
         }
-        let row_idx = self.pattern.row_idx();
+        let row_idx = self.structure.pattern.row_idx();
         for j in 0..self.n_rows {
             let sj = self.scale[j];
             for p in col_ptr[j]..col_ptr[j + 1] {
@@ -180,9 +187,9 @@ impl<const D: usize> NormalMatrix<D> {
             for j in 0..self.n_rows {
                 values[col_ptr[j]] += shift;
             }
-            let factored = self.symbolic.factorize_numeric_llt(
+            let factored = self.structure.symbolic.factorize_numeric_llt(
                 &mut self.factor,
-                SparseColMatRef::new(self.pattern.as_ref(), values),
+                SparseColMatRef::new(self.structure.pattern.as_ref(), values),
                 Side::Lower,
                 LltRegularization {
                     dynamic_regularization_delta: settings.pivot_delta,
@@ -217,7 +224,7 @@ impl<const D: usize> NormalMatrix<D> {
             *v *= s;
         }
         let n = self.n_rows;
-        let factor = LltRef::new(&self.symbolic, &self.factor);
+        let factor = LltRef::new(&self.structure.symbolic, &self.factor);
         factor.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(r, n, 1),
@@ -306,7 +313,7 @@ mod tests {
     #[test]
     fn own_supernodal_solve_matches_faer() {
         let lp = grid_lp(60);
-        let mut normal = NormalMatrix::new(&lp, &IpmSettings::plan()).expect("normal matrix");
+        let mut normal = NormalMatrix::new(&lp, &IpmSettings::plan(), None).expect("normal matrix");
         assert!(
             normal.supernodes.is_some(),
             "faer chose a simplicial factor"
@@ -323,7 +330,7 @@ mod tests {
         normal.precondition(&mut own);
         let mut reference: Vec<f64> = b.iter().zip(&normal.scale).map(|(v, s)| v * s).collect();
         let n = normal.n_rows;
-        LltRef::new(&normal.symbolic, &normal.factor).solve_in_place_with_conj(
+        LltRef::new(&normal.structure.symbolic, &normal.factor).solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(&mut reference, n, 1),
             Par::Seq,

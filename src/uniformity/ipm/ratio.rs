@@ -34,7 +34,7 @@ pub(crate) fn solve<const D: usize>(
 ) -> Result<IpmSolution, IpmError> {
     settings.validate()?;
     let program = Program::new(lp, *settings)?;
-    let normal = NormalMatrix::new(lp, settings)?;
+    let normal = NormalMatrix::new(lp, settings, start.map(|w| &w.pattern))?;
     let mut b = vec![0.0; normal.n_rows];
     // b = −A lb.
     normal.a_mul(&program.lower, &mut b);
@@ -50,16 +50,20 @@ pub(crate) fn solve<const D: usize>(
         rs: 0.0,
         scaling: None,
         corrector_residual: 0.0,
-        warm: start.map(|w| w.0.clone()),
+        warm: start.and_then(|w| w.point.clone()),
     };
     let outcome = driver::run(&mut system, settings);
+    let kept = Some(WarmStart {
+        point: outcome.kept,
+        pattern: system.normal.pattern(),
+    });
     let Some(point) = outcome.point else {
         return Ok(IpmSolution {
             q: program.lower.clone(),
             iterations: 0,
             termination: Termination::NumericalError,
             residuals: [f64::NAN; 3],
-            kept: None,
+            kept,
         });
     };
     let measures = outcome.measures;
@@ -78,7 +82,7 @@ pub(crate) fn solve<const D: usize>(
             iterations: outcome.iterations,
             termination: outcome.termination,
             residuals,
-            kept: outcome.kept.map(WarmStart),
+            kept,
         });
     }
     let (q, primal) = program.polish(&mut system.normal, q);
@@ -91,7 +95,7 @@ pub(crate) fn solve<const D: usize>(
             outcome.termination
         },
         residuals: [primal, measures.dual, measures.gap],
-        kept: outcome.kept.map(WarmStart),
+        kept,
     })
 }
 

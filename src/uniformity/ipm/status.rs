@@ -4,23 +4,56 @@
 //! iterate it kept for a neighbouring LP ([`WarmStart`]).
 
 use std::fmt;
+use std::sync::Arc;
 
 use super::system::Point;
 use crate::status::Termination;
+use crate::uniformity::block_pattern::BlockPattern;
 
-/// An interior iterate of a ratio LP kept at a moderate gap
-/// (`IpmSettings::keep_at_gap`, crate-private): the start of the LP of a
-/// neighbouring geometry of the same net — the outer loop's next boundary,
-/// micrometres away — which then follows its own central path from there.
-/// Opaque: only the ratio LP reads it, and only when its sizes match.
+/// What a ratio LP leaves to the LP of a neighbouring geometry of the same
+/// net — the outer loop's next boundary, micrometres away: an interior
+/// iterate kept at a moderate gap (`IpmSettings::keep_at_gap`,
+/// crate-private), from which that LP follows its own central path, and
+/// its normal matrix's ordering and symbolic factorisation, so that LP
+/// factors numerically only (the analysis once per design). Opaque: only
+/// the ratio LP reads it, and only what fits its own sizes and net.
 #[derive(Clone)]
-pub struct WarmStart(pub(crate) Point);
+pub struct WarmStart {
+    /// The kept iterate (`None` when the LP did not keep one).
+    pub(crate) point: Option<Point>,
+    /// The normal matrix's pattern and analysis.
+    pub(crate) pattern: Arc<BlockPattern>,
+}
+
+impl WarmStart {
+    /// Whether an iterate was kept (the analysis always is).
+    pub fn has_iterate(&self) -> bool {
+        self.point.is_some()
+    }
+
+    /// The analysis alone: an LP of the same net started from its own
+    /// point (a cold start that still refactors numerically only).
+    pub(crate) fn without_iterate(&self) -> WarmStart {
+        WarmStart {
+            point: None,
+            pattern: Arc::clone(&self.pattern),
+        }
+    }
+}
 
 impl fmt::Debug for WarmStart {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let point = self.point.as_ref();
         f.debug_struct("WarmStart")
-            .field("pairs", &self.0.primal.len())
-            .field("free", &(self.0.free_primal.len() + self.0.free_dual.len()))
+            .field("pairs", &point.map(|p| p.primal.len()))
+            .field(
+                "free",
+                &point.map(|p| p.free_primal.len() + p.free_dual.len()),
+            )
+            .field(
+                "pattern_rows",
+                &self.pattern.col_ptr.len().saturating_sub(1),
+            )
             .finish()
     }
 }
@@ -44,7 +77,8 @@ pub(crate) struct IpmSolution {
     pub termination: Termination,
     /// Final relative primal residual, dual residual and gap.
     pub residuals: [f64; 3],
-    /// The iterate kept for a neighbouring LP, when the settings ask for one
-    /// and the method got that far.
+    /// What a neighbouring LP starts from: the iterate kept (when the
+    /// settings ask for one and the method got that far) and the normal
+    /// matrix's analysis; `None` only when the normal matrix was not set up.
     pub kept: Option<WarmStart>,
 }

@@ -163,3 +163,35 @@ fn centrality_correctors_reach_the_same_plan_optimum() {
         );
     }
 }
+
+/// The normal matrix's analysis travels with the kept iterate: an LP of the
+/// same net factors numerically with it and reaches, bit for bit, what its
+/// own analysis reaches; an LP of another net makes its own.
+#[test]
+fn a_neighbouring_lps_analysis_is_reused_only_where_it_fits() {
+    use crate::uniformity::plan::PlanReduction;
+    use std::sync::Arc;
+    let plan_of = |path: &str| PlanReduction::new(&problem(path)).expect("a reflector mesh");
+    let settings = IpmSettings::plan();
+    let paper = plan_of("problems/paper-26m.toml");
+    let first = solve(paper.lp(), &settings, None).expect("plan");
+    let kept = first.kept.expect("an analysis kept");
+    assert!(kept.has_iterate());
+    let analysis = kept.without_iterate();
+    let again = solve(paper.lp(), &settings, Some(&analysis)).expect("plan");
+    let reused = again.kept.expect("an analysis kept").pattern;
+    assert!(Arc::ptr_eq(&reused, &kept.pattern), "not reused");
+    assert_eq!(again.iterations, first.iterations);
+    assert_eq!(again.q, first.q);
+
+    let hex = plan_of("problems/small-hex.toml");
+    let own = solve(hex.lp(), &settings, None).expect("plan");
+    let given = solve(hex.lp(), &settings, Some(&analysis)).expect("plan");
+    let made = given.kept.expect("an analysis kept").pattern;
+    assert!(
+        !Arc::ptr_eq(&made, &kept.pattern),
+        "another net's analysis used"
+    );
+    assert_eq!(given.termination, Termination::Converged);
+    assert_eq!(given.q, own.q);
+}

@@ -129,6 +129,7 @@ impl<'a> Kkt<'a> {
             col_ptr,
             pattern,
             symbolic,
+            ..
         } = BlockPattern::new(&ends, n_free, B)?;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_ldlt_scratch::<f64>(PAR, Default::default()),
