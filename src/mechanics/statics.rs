@@ -179,9 +179,9 @@ impl Linearisation<'_> {
     /// changed by the last step — the exact tangent is factored instead:
     /// the kept stiffness, wrong by 1e-2 EA/L on every slack cable, makes
     /// Newton's convergence linear there. A step whose
-    /// residual grows is halved, at most
-    /// [`LINE_SEARCH_HALVINGS`] times, and the least residual tried kept: a
-    /// full step past cables going slack overshoots. (super-60m's tolerance
+    /// residual grows more than [`ACCEPTED_RESIDUAL_GROWTH`]-fold is halved,
+    /// at most [`LINE_SEARCH_HALVINGS`] times, and the least residual tried
+    /// kept: a full step past cables going slack overshoots. (super-60m's tolerance
     /// samples, ≈ 800 cables slackening each: 12–14 iterations with the
     /// halving, 16–33 without, and with at most 4 refactorisations the
     /// chord failed and load steps took over, 3.7× the time.) `None` (the
@@ -264,8 +264,10 @@ impl Linearisation<'_> {
             if !size.is_finite() {
                 return Ok(None);
             }
-            // The step, halved while the residual grows: a full step past
-            // cables going slack (or taut again) can overshoot by far.
+            // The step, halved while the residual grows too much: a full
+            // step past cables going slack (or taut again) can overshoot by
+            // far; one that brings the slack cables nearer their set raises
+            // the residual a little for an iteration.
             let norm = norm2(&ev.residual);
             let mut best: Option<(f64, f64, State, Evaluation)> = None;
             let mut fraction = 1.0;
@@ -275,7 +277,7 @@ impl Linearisation<'_> {
                 let trial_ev =
                     system.evaluate_with(changed, &trial, self.lambda, SLACK_ITERATION_RATIO);
                 let trial_norm = norm2(&trial_ev.residual);
-                let decreases = trial_norm < norm;
+                let decreases = trial_norm < ACCEPTED_RESIDUAL_GROWTH * norm;
                 if trial_norm.is_finite() && best.as_ref().is_none_or(|b| trial_norm < b.1) {
                     best = Some((fraction, trial_norm, trial, trial_ev));
                 }
@@ -342,7 +344,19 @@ const POLISHING_STEPS: usize = 3;
 /// on a full one, took 36–39 iterations.)
 pub const SLACK_ITERATION_RATIO: f64 = 1e-2;
 
-/// Halvings of a step of [`Linearisation::solve`] whose residual grows.
+/// The growth of the residual by which [`Linearisation::solve`] still takes
+/// a step (not monotone: the first Newton steps through cables going slack
+/// raise the residual while the slack set settles, and halving them slowed
+/// that). `cargo bench --bench budget`, two threads, growth 1 / 2 / 3 / 10
+/// (no growth ↔ halving while the residual grows): four samples of
+/// super-100m 32.4 / 30.6 / 29.8 / 32.7 s, eight of super-60m 13.5 /
+/// 12.7 / 13.3 / 12.7 s; 1 000 of realistic-26m 20.0 / 20.4 s (1, 2). Two
+/// super-100m samples, one thread, iterations (refactorisations): 12 (9)
+/// and 16 (10) at 1; 12 (7) and 15 (9) at 3; 14 (8) each with no halving.
+const ACCEPTED_RESIDUAL_GROWTH: f64 = 2.0;
+
+/// Halvings of a step of [`Linearisation::solve`] whose residual grows
+/// more than [`ACCEPTED_RESIDUAL_GROWTH`]-fold.
 const LINE_SEARCH_HALVINGS: usize = 3;
 
 /// Largest ratio of a chord increment to the one before that
