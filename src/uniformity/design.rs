@@ -160,9 +160,10 @@ pub struct Design {
     /// the nodes whose cables can only be slack (also in `warnings`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub slack_nodes: Option<SlackNodes>,
-    /// The interior point's iterate kept for the solve of a neighbouring
-    /// problem ([`super::UniformitySolver::solve_from`]: `lp`'s plan route,
-    /// the outer loop's next boundary). Not part of the design's files.
+    /// What the interior point keeps for the solve of a neighbouring
+    /// problem — its iterate, its normal matrix's analysis —
+    /// ([`super::UniformitySolver::solve_from`]: `lp`'s plan route, the
+    /// outer loop's next boundary). Not part of the design's files.
     #[serde(skip)]
     pub warm_start: Option<Arc<WarmStart>>,
 }

@@ -136,7 +136,8 @@ impl Lp {
 }
 
 /// What the routes found: unscaled `q` (`None`: infeasible), iterations,
-/// the route taken, and the plan interior point's kept iterate.
+/// the route taken, and what the plan interior point keeps for a
+/// neighbouring LP (its iterate, its normal matrix's analysis).
 struct Routed {
     q: Option<Vec<f64>>,
     iterations: usize,
@@ -227,7 +228,7 @@ enum PlanFallback {
 
 /// The plan problem (interior point, `plan.rs`, from `warm` when given),
 /// completed with the ties and the rear net: unscaled `q`, iterations, and
-/// the iterate kept for the next neighbouring LP. A warm start that does not
+/// what it keeps for the next neighbouring LP. A warm start that does not
 /// converge (stalled included) is said in `warnings` and the LP solved again
 /// from its own start.
 fn solve_plan(
@@ -238,7 +239,7 @@ fn solve_plan(
 ) -> Result<(Vec<f64>, usize, Option<WarmStart>), PlanFallback> {
     let settings = IpmSettings::plan();
     let mut solution = ipm::solve(plan.lp(), &settings, warm)?;
-    if warm.is_some() && solution.termination != Termination::Converged {
+    if warm.is_some_and(WarmStart::has_iterate) && solution.termination != Termination::Converged {
         warnings.push(format!(
             "lp: the plan interior point from the neighbouring design's iterate stopped with \
              {:?} after {} iterations; solved again from its own start",
@@ -264,7 +265,7 @@ fn solve_plan(
         }
     }
     let q = plan.complete(problem, &solution.q)?;
-    Ok((q, solution.iterations, solution.kept))
+    Ok((q, solution.iterations, Some(solution.kept)))
 }
 
 /// The plan LP of `plan` as one conic program (clarabel, QDLDL first): two

@@ -5,11 +5,11 @@
 //! (`supernodal.rs`'s kernel on a supernodal factor) and with iterative
 //! refinement against the exact `M`.
 
+use std::sync::Arc;
+
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::LltRef;
-use std::sync::Arc;
-
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par, Side};
 

@@ -16,8 +16,9 @@ use crate::fdm::NONE;
 use crate::status::Termination;
 
 /// Solves the ratio LP with the structured interior-point method and
-/// `settings`, from `start` when it is an iterate of an LP of the same sizes
-/// (else from Mehrotra's point). The returned `q` is unscaled (smallest set
+/// `settings`, from `start`'s iterate when it has one of an LP of the same
+/// sizes (else from Mehrotra's point), with `start`'s analysis of the
+/// normal matrix where it fits this LP's net. The returned `q` is unscaled (smallest set
 /// tension ≈ 1); the caller rescales it.
 ///
 /// # Errors
@@ -53,10 +54,10 @@ pub(crate) fn solve<const D: usize>(
         warm: start.and_then(|w| w.point.clone()),
     };
     let outcome = driver::run(&mut system, settings);
-    let kept = Some(WarmStart {
+    let kept = WarmStart {
         point: outcome.kept,
         pattern: system.normal.pattern(),
-    });
+    };
     let Some(point) = outcome.point else {
         return Ok(IpmSolution {
             q: program.lower.clone(),

@@ -79,6 +79,6 @@ pub(crate) struct IpmSolution {
     pub residuals: [f64; 3],
     /// What a neighbouring LP starts from: the iterate kept (when the
     /// settings ask for one and the method got that far) and the normal
-    /// matrix's analysis; `None` only when the normal matrix was not set up.
-    pub kept: Option<WarmStart>,
+    /// matrix's analysis.
+    pub kept: WarmStart,
 }
