@@ -351,12 +351,19 @@ const POLISHING_STEPS: usize = 3;
 
 /// The axial stiffness, as a fraction of EA, a slack cable keeps in the
 /// matrix [`Linearisation::solve`] refactors (its residual is exact, so its
-/// equilibrium is the same). On a super-100m tolerance sample (σ = 2 µm on
-/// cut lengths, ≈ 5 800 cables ending slack), one thread: the exact tangent
+/// equilibrium is the same). Measured when this matrix was refactored to the
+/// end and every growth of the residual halved, on a super-100m tolerance
+/// sample (σ = 2 µm on cut lengths, ≈ 5 800 cables ending slack), one
+/// thread: the exact tangent
 /// (1e-9) took 19 iterations and 15 refactorisations, 19.8 s; 1e-3: 17 and
 /// 10, 14.7 s; 1e-2: 12 and 9, 12.3 s; 3e-2: 15 and 9, 12.9 s; 1e-1: 16
 /// and 12, 16.3 s. (A ratio adapted per step, ×10 on a halved step and ÷10
 /// on a full one, took 36–39 iterations.)
+///
+/// Measured again with [`SETTLED_SLACK_CHANGE`] and
+/// [`ACCEPTED_RESIDUAL_GROWTH`], four super-100m samples on two threads:
+/// 3e-3 34.0 s, 1e-2 30.4–32.4 s, 3e-2 29.2–31.4 s, 1e-1 42.6 s; eight of
+/// super-60m 12.8 s at 1e-2 against 14.3 s at 3e-2, so 1e-2 stays.
 pub const SLACK_ITERATION_RATIO: f64 = 1e-2;
 
 /// The growth of the residual by which [`Linearisation::solve`] still takes
