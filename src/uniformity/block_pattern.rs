@@ -37,8 +37,9 @@ pub(crate) struct BlockPattern {
     pub(crate) col_ptr: Vec<usize>,
     pub(crate) pattern: SymbolicSparseColMat<usize>,
     pub(crate) symbolic: SymbolicCholesky<usize>,
-    /// What it was made for: the cables' ends, the free nodes, the block.
-    ends: Vec<[usize; 2]>,
+    /// What it was made for: the cables' ends (free indices, `NONE` for a
+    /// fixed end), the free nodes, the block.
+    pub(crate) ends: Vec<[usize; 2]>,
     n_free: usize,
     b: usize,
 }

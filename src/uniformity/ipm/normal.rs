@@ -32,12 +32,11 @@ const PAR: Par = Par::Seq;
 /// its symbolic factorisation, and the numeric factor of the current iteration.
 pub(super) struct NormalMatrix<const D: usize> {
     pub(super) n_rows: usize,
-    /// Free indices of each cable's ends (`NONE` for a fixed end).
-    ends: Vec<[usize; 2]>,
     /// Edge vectors in the `D` coordinates.
     u: Vec<[f64; D]>,
-    /// The pattern, its ordering and symbolic factorisation: shared with
-    /// the LPs of neighbouring geometries of the same net ([`super::WarmStart`]).
+    /// The pattern, its ordering and symbolic factorisation, and the
+    /// cables' ends it was made of: shared with the LPs of neighbouring
+    /// geometries of the same net ([`super::WarmStart`]).
     structure: Arc<BlockPattern>,
     /// Values of `M`, scaled to unit diagonal.
     values: Vec<f64>,
@@ -85,7 +84,6 @@ impl<const D: usize> NormalMatrix<D> {
         let supernodes = Supernodes::of(symbolic);
         Ok(NormalMatrix {
             n_rows,
-            ends,
             u,
             values: vec![0.0; structure.col_ptr[n_rows]],
             structure,
@@ -105,7 +103,7 @@ impl<const D: usize> NormalMatrix<D> {
     /// `out = A v` (n_rows).
     pub(super) fn a_mul(&self, v: &[f64], out: &mut [f64]) {
         out.fill(0.0);
-        for ((&[a, b], uk), &vk) in self.ends.iter().zip(&self.u).zip(v) {
+        for ((&[a, b], uk), &vk) in self.structure.ends.iter().zip(&self.u).zip(v) {
             if a != NONE {
                 for c in 0..D {
                     out[D * a + c] += uk[c] * vk;
@@ -121,7 +119,7 @@ impl<const D: usize> NormalMatrix<D> {
 
     /// `out = Aᵀ y` (n_edges).
     pub(super) fn at_mul(&self, y: &[f64], out: &mut [f64]) {
-        for ((&[a, b], uk), o) in self.ends.iter().zip(&self.u).zip(out.iter_mut()) {
+        for ((&[a, b], uk), o) in self.structure.ends.iter().zip(&self.u).zip(out.iter_mut()) {
             let mut sum = 0.0;
             for c in 0..D {
                 if a != NONE {
@@ -140,7 +138,7 @@ impl<const D: usize> NormalMatrix<D> {
         let values = &mut self.values;
         values.fill(0.0);
         let col_ptr = &self.structure.col_ptr;
-        for (k, (&[a, b], uk)) in self.ends.iter().zip(&self.u).enumerate() {
+        for (k, (&[a, b], uk)) in self.structure.ends.iter().zip(&self.u).enumerate() {
             let t = theta[k];
             for end in [a, b] {
                 if end != NONE {

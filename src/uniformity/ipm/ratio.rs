@@ -18,8 +18,8 @@ use crate::status::Termination;
 /// Solves the ratio LP with the structured interior-point method and
 /// `settings`, from `start`'s iterate when it has one of an LP of the same
 /// sizes (else from Mehrotra's point), with `start`'s analysis of the
-/// normal matrix where it fits this LP's net. The returned `q` is unscaled (smallest set
-/// tension ≈ 1); the caller rescales it.
+/// normal matrix where it fits this LP's net. The returned `q` is unscaled
+/// (smallest set tension ≈ 1); the caller rescales it.
 ///
 /// # Errors
 /// A setting out of range, an LP the method does not take (a tension floor
