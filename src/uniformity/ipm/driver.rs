@@ -132,9 +132,13 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
         let score = (measures.primal / pt)
             .max(measures.dual / dt)
             .max(measures.gap / gt);
-        // An iterate within the primal tolerance beats any outside it.
-        let key = (measures.primal > pt, score);
-        let better = |b: &Best| key < (b.measures.primal > pt, b.score);
+        // An iterate that could be accepted beats any that could not (the
+        // order must agree with the acceptance below, or a best iterate
+        // outside the reduced tolerances holds its place against every
+        // acceptable one to the iteration limit); then one within the
+        // primal tolerance beats any outside it.
+        let key = (!reduced(&measures), measures.primal > pt, score);
+        let better = |b: &Best| key < (!reduced(&b.measures), b.measures.primal > pt, b.score);
         if converged || best.as_ref().is_none_or(better) {
             best = Some(Best {
                 score,
