@@ -223,8 +223,8 @@ fn ringmesh_row(
 
 /// `gradient`'s row, with the settings of `ringmesh uniformity --solver
 /// gradient` (`SolverKind::Gradient`'s defaults); its route column says the
-/// exact finish's programs, their interior-point iterations and the warnings
-/// (each printed).
+/// exact finish's programs (steps and second-order corrections), their
+/// interior-point iterations and the warnings (each printed).
 fn gradient_row(repeats: usize, p: &UniformityProblem) -> Row {
     let gradient = Gradient {
         exact_finish: true,
@@ -240,8 +240,10 @@ fn gradient_row(repeats: usize, p: &UniformityProblem) -> Row {
                 solver: "gradient",
                 backend: "",
                 route: format!(
-                    "exact finish: {} programs, {} interior-point iterations, {} warnings",
+                    "exact finish: {} programs + {} corrections, {} interior-point iterations, \
+                     {} warnings",
                     history.finish_steps,
+                    history.finish_corrections,
                     history.finish_interior_iterations,
                     d.warnings.len()
                 ),

@@ -16,8 +16,10 @@ pub struct History {
     pub evaluations: usize,
     /// L-BFGS runs (the preconditioner is re-linearised for each).
     pub runs: usize,
-    /// Quadratic programs of the exact finish (0 without it).
+    /// Quadratic programs of the exact finish (0 without it), one a step.
     pub finish_steps: usize,
+    /// Programs the finish solved again as second-order corrections.
+    pub finish_corrections: usize,
     /// Interior-point iterations of those programs.
     pub finish_interior_iterations: usize,
     /// With the exact finish, `J` with the exact `ln(Tmax/Tmin)` at the end.

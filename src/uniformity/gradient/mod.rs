@@ -251,6 +251,7 @@ impl Gradient {
             evaluations: 1,
             runs: 0,
             finish_steps: 0,
+            finish_corrections: 0,
             finish_interior_iterations: 0,
             exact_objective: None,
         };
@@ -343,6 +344,7 @@ impl Gradient {
             let program = crate::uniformity::ipm::IpmSettings::finish();
             let finished = finish::finish(&objective, &q, &self.finish, &program)?;
             history.finish_steps = finished.steps;
+            history.finish_corrections = finished.corrections;
             history.finish_interior_iterations = finished.interior_iterations;
             history.exact_objective = Some(finished.objective);
             warnings.extend(finished.warnings);

@@ -289,6 +289,16 @@ impl StepModel {
         }
     }
 
+    /// The force densities `q_k (1 + p_k)` of the step `z` from `q`, each
+    /// `p_k` held to its cable's box.
+    pub(super) fn force_densities(&self, q: &[f64], z: &[f64]) -> Vec<f64> {
+        q.iter()
+            .zip(z)
+            .zip(&self.cables)
+            .map(|((&q, &p), cable)| q * (1.0 + p.clamp(cable.lo, cable.hi)))
+            .collect()
+    }
+
     /// The feasible point of `p`, the relative changes in `z`: `p` clamped
     /// to its box, `ξ` the linearised equilibrium's answer to it (`D ξ =
     /// −Σ_k ±q_k u_k p_k` at every free node, eq. 3–4, with `solve_d` solving
