@@ -181,10 +181,12 @@ pub struct FinishSettings {
     /// (`tests/common/nets.rs`): the model's `ln(Tmax/Tmin)` was 1e-3 off at
     /// a radius of 0.05 (the tensions' nonlinearity in `q`), steps were
     /// refused until the radius sat near 1e-2, and 50 programs ended in
-    /// `MaxIterations` at 463 and 1 021 free nodes; with it 9 and 8 steps
-    /// (and as many corrections) converged, and at 2 431 free nodes 11
-    /// steps against 21. The hexagonal and sector nets, whose steps the
-    /// model predicts well, are unchanged.
+    /// `MaxIterations` at 463, 1 021 and 2 431 free nodes (3.0, 12.0,
+    /// 45.2 s); with it 7 + 5, 7 + 6 and 8 + 7 programs (steps +
+    /// corrections) converge (0.8, 3.6, 15.8 s), to a `J` lower by 3e-6 …
+    /// 3e-5 relative (`tests/ipm_families.rs`, `finish_table`). The
+    /// hexagonal and sector nets, whose steps the model predicts well, are
+    /// unchanged.
     pub second_order_correction: bool,
 }
 

@@ -272,3 +272,73 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A system whose iterates measure as scripted (the last one repeated),
+    /// with zero directions: what the driver makes of the measures alone.
+    struct Scripted {
+        measures: Vec<Measures>,
+        calls: usize,
+    }
+
+    impl NewtonSystem for Scripted {
+        type Error = std::convert::Infallible;
+
+        fn pair_blocks(&self) -> Vec<usize> {
+            vec![1]
+        }
+
+        fn start(&mut self) -> Result<Point, Self::Error> {
+            Ok(Point {
+                primal: vec![1.0],
+                dual: vec![1.0],
+                free_primal: vec![0.0],
+                free_dual: Vec::new(),
+            })
+        }
+
+        fn residuals(&mut self, _: &Point) -> Measures {
+            let m = self.measures[self.calls.min(self.measures.len() - 1)];
+            self.calls += 1;
+            m
+        }
+
+        fn factor(&mut self, _: &Point) -> Result<(), Self::Error> {
+            Ok(())
+        }
+
+        fn direction(&mut self, point: &Point, _: &[f64], _: Rhs) -> Result<Point, Self::Error> {
+            let mut zero = point.clone();
+            zero.add_scaled(-1.0, point);
+            Ok(zero)
+        }
+    }
+
+    /// With the exact finish's settings (primal 1e-8, reduced 1e-6, gap
+    /// 1e-10 either way): an early iterate inside the primal tolerance but
+    /// outside the gap's, then iterates whose primal residual stays at
+    /// 1.3e-8 with the gap converged. The acceptable iterate is the best,
+    /// the method stalls on it after `stall_iterations`; it does not run to
+    /// the iteration limit holding the unacceptable one.
+    #[test]
+    fn an_acceptable_iterate_beats_one_the_acceptance_refuses() {
+        let settings = IpmSettings::finish();
+        let measure = |primal, gap| Measures {
+            primal,
+            dual: 1e-14,
+            gap,
+        };
+        let floor = measure(1.3e-8, 4e-11);
+        let mut system = Scripted {
+            measures: vec![measure(1e-2, 1.0), measure(5e-9, 1e-9), floor],
+            calls: 0,
+        };
+        let outcome = run(&mut system, &settings);
+        assert_eq!(outcome.termination, Termination::Stalled);
+        assert_eq!(outcome.measures, floor);
+        assert_eq!(outcome.iterations, 2 + settings.stall_iterations);
+    }
+}

@@ -226,14 +226,25 @@ impl IpmSettings {
     /// (`gradient/finish/ipm.rs`): residuals to 1e-8 (clarabel's default),
     /// the gap to 1e-10 of `max(1, |f|)` — the finish compares the model's
     /// optimum with `J` to `10⁻⁹ J` — or [`Self::coarse_gap`] of the decrease;
-    /// a program that stalls is accepted with residuals to 1e-6 (they can
-    /// stall a little above 1e-8 at the edge of the directions' precision,
-    /// 2–5e-8 on realistic-26m in the design loop, and the finish reads the
-    /// point only after re-solving its equilibrium). One common step, 0.99
-    /// of the way to the boundary; an LDLᵀ of the quasi-definite reduced
-    /// system with a static shift of 1e-10 and pivots below 1e-13 replaced
-    /// by ±1e-8, refined to a backward error of 1e-10 (0 steps for the
-    /// predictor).
+    /// a program that stalls is accepted with residuals to 1e-6 (the finish
+    /// reads the point only after re-solving its equilibrium). One common
+    /// step, 0.99 of the way to the boundary; an LDLᵀ of the quasi-definite
+    /// reduced system with a static shift of 1e-12 of its unit diagonal and
+    /// pivots below 1e-13 replaced by ±1e-8, refined to a backward error of
+    /// 1e-10 (0 steps for the predictor).
+    ///
+    /// The shift was 1e-10. Near a program's optimum refinement could then
+    /// no longer resolve the linearised equilibrium (its residual stalled at
+    /// 1.3e-8 on the hexagonal nets, 2–5e-8 on realistic-26m), the programs
+    /// ran to their stall test, and the finish certified points whose `J`
+    /// lay 2e-8 `J` above the ones it reaches now. Measured on the three net
+    /// families of issue 38 (`tests/ipm_families.rs`, `finish_table`), at
+    /// 1e-10 → 1e-12: hex 1 021 free nodes 63 → 21 interior-point iterations
+    /// (0.9 → 0.4 s), 2 431: 49 → 21, 9 913: 49 → 28 and 5 → 3 programs
+    /// (18.4 → 10.9 s); jitter 2 431: 385 → 261 (21 → 13 s); sector
+    /// unchanged; `J` lower on every net. The design loop of realistic-26m
+    /// with `gradient` took 3.8 → 1.05 s to the same ratio. 1e-13 gave the
+    /// same counts.
     pub(crate) fn finish() -> Self {
         IpmSettings {
             primal_tolerance: 1e-8,
@@ -246,7 +257,7 @@ impl IpmSettings {
             step_length: StepLength::Fixed(0.99),
             separate_steps: false,
             pivot_delta: 1e-8,
-            regularization: 1e-10,
+            regularization: 1e-12,
             refinement_steps: 30,
             predictor_refinement_steps: 0,
             refinement_tolerance: 1e-10,
