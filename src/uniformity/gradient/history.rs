@@ -20,7 +20,7 @@ pub struct History {
     pub finish_steps: usize,
     /// Programs the finish solved again as second-order corrections.
     pub finish_corrections: usize,
-    /// Interior-point iterations of those programs.
+    /// Interior-point iterations of all programs, corrections included.
     pub finish_interior_iterations: usize,
     /// With the exact finish, `J` with the exact `ln(Tmax/Tmin)` at the end.
     pub exact_objective: Option<f64>,

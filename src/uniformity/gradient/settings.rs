@@ -155,7 +155,8 @@ pub struct FinishSettings {
     /// The finish has converged when the model's predicted decrease is at
     /// most this times `J_exact`.
     pub tolerance: f64,
-    /// Most steps (quadratic programs) of the finish.
+    /// Most steps of the finish: a quadratic program each, two where a step
+    /// is corrected ([`Self::second_order_correction`]).
     pub max_steps: usize,
     /// The first trust radius, relative change of `q`.
     pub first_radius: f64,

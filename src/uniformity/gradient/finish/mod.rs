@@ -40,7 +40,11 @@
 //! The step is taken on `q` alone (the geometry follows by a forward solve)
 //! when `J_exact` falls by more than a tenth of the decrease the model
 //! predicts; the radius doubles (to at most ½) when the model predicts well
-//! (three quarters of it) and shrinks ×4 when it does not.
+//! (three quarters of it) and shrinks ×4 when it does not. The finish has
+//! converged when the model predicts a decrease of at most
+//! [`FinishSettings::tolerance`]`·J`: no step of the linearised problem
+//! lowers `J_exact` further, a stationarity certificate of the nonsmooth
+//! problem that does not depend on the net's size.
 //!
 //! A step that falls short of three quarters is first corrected
 //! ([`FinishSettings::second_order_correction`]): the tensions at the trial
@@ -52,17 +56,18 @@
 //! prediction: the second-order correction of SQP against the Maratos
 //! effect, where the linearised max/min refuses steps that lower `J`. On
 //! the jittered grid most corrected trials met their prediction to a few
-//! per cent (0.93–1.06 of it, where the first trials had met −2…0.7). The finish has converged when the model
-//! predicts a decrease of at most [`FinishSettings::tolerance`]`·J`: no step of the
-//! linearised problem lowers `J_exact` further, a stationarity certificate of
-//! the nonsmooth problem that does not depend on the net's size.
+//! per cent (0.93–1.06 of it, where the first trials had met −2…0.7). A
+//! corrected trial that meets three quarters of the prediction doubles the
+//! radius like any other: the step, not the model, is what is judged. The
+//! correction's multipliers replace the step's only with its trial.
 //!
 //! The program is solved by the crate's interior point (`uniformity/ipm`)
 //! on its structure (`ipm.rs`, with the Newton systems reduced to the node
-//! graph in `kkt.rs`, settings [`IpmSettings::finish`]): 7–11
-//! iterations of one sparse LDLᵀ of `6 n_free` unknowns each cold, 5–7 warm
-//! from the previous step's multipliers — 7–13× faster than clarabel on the
-//! program stated generically. clarabel remains the fallback, and the
+//! graph in `kkt.rs`, settings [`IpmSettings::finish`]): 6–10
+//! iterations of one sparse LDLᵀ of `6 n_free` unknowns a program on the
+//! hexagonal and sector nets of issue 38, warm from the previous step's
+//! multipliers, 17–24 on the jittered one — 7–13× faster than clarabel on
+//! the program stated generically (measured when programs took 5–11). clarabel remains the fallback, and the
 //! cross-check of the tests; a program neither solves ([`ProgramFailed`])
 //! ends the finish as `Stalled`, with both reasons in a warning. Either
 //! solver's point is made feasible before its value is read
@@ -150,7 +155,8 @@ pub(super) struct Finished {
     pub(super) steps: usize,
     /// Programs solved again as second-order corrections.
     pub(super) corrections: usize,
-    /// Interior-point iterations of those programs (clarabel's not counted).
+    /// Interior-point iterations of all programs, corrections included
+    /// (clarabel's not counted).
     pub(super) interior_iterations: usize,
     pub(super) termination: Termination,
     pub(super) warnings: Vec<String>,
@@ -216,11 +222,12 @@ pub(super) fn finish(
         let mut j_trial = evaluate(&trial);
         if settings.second_order_correction && j - j_trial < GOOD_AGREEMENT * predicted {
             if let Some(corrected) = corrected_step(objective, &model, &z, &trial) {
+                let mut corrected_multipliers = multipliers.clone();
                 match solve(
                     &corrected,
                     &eq,
                     program,
-                    &mut multipliers,
+                    &mut corrected_multipliers,
                     &mut interior_iterations,
                     steps,
                     &mut warnings,
@@ -231,6 +238,7 @@ pub(super) fn finish(
                         let j_second = evaluate(&second);
                         if j_second < j_trial {
                             (trial, j_trial) = (second, j_second);
+                            multipliers = corrected_multipliers;
                         }
                     }
                     Err(failed) => warnings.push(format!(
@@ -274,7 +282,8 @@ pub(super) fn finish(
 /// module documentation): `model` with each set row's `s_k` shifted by what
 /// its linearisation missed at the trial, `ln(T_k(trial)/t_g) − (s_k +
 /// δs_k(z))`, about the same point. `None` when the trial has no forward
-/// solve (its `J` is then already infinite).
+/// solve (its `J` is then already infinite) or a set cable without tension
+/// there.
 fn corrected_step(
     objective: &Objective,
     model: &StepModel,
@@ -287,6 +296,9 @@ fn corrected_step(
     for (set, members) in problem.sets().iter().zip(corrected.sets.iter_mut()) {
         for (k, s) in members.iter_mut() {
             let at_trial = (reached.edges_forces_n[*k] / set.mean_tension_n).ln();
+            if !at_trial.is_finite() {
+                return None;
+            }
             *s = at_trial - model.delta_s(*k, z);
         }
     }
