@@ -232,21 +232,28 @@ fn iteration_table() {
     }
 }
 
-/// The gradient's exact finish per family at `RINGMESH_FINISH_FREE` free
-/// nodes (default 10 000): its programs and their interior-point iterations
-/// (issue 38, item 4). Measurement, not a check: `cargo test --release
-/// --test ipm_families finish_table -- --ignored --nocapture`.
+/// The gradient's exact finish per family (`RINGMESH_FINISH_FAMILIES`,
+/// comma-separated, default all) at `RINGMESH_FINISH_FREE` free nodes
+/// (default 10 000): its programs, their interior-point iterations, `J`,
+/// and its time over `lp`'s on the same net in the same run (issue 38's
+/// ≤ 5× target). Measurement, not a check: `cargo test --release --test
+/// ipm_families finish_table -- --ignored --nocapture`.
 #[test]
 #[ignore = "measurement: prints a table"]
 fn finish_table() {
+    let families = std::env::var("RINGMESH_FINISH_FAMILIES").unwrap_or_default();
+    let chosen = |family: Family| {
+        families.is_empty() || families.split(',').any(|f| f.trim() == family.name())
+    };
     for free in sizes("RINGMESH_FINISH_FREE", "10000") {
-        for family in Family::ALL {
+        for family in Family::ALL.into_iter().filter(|&f| chosen(f)) {
             let problem = family.problem(rings_for(free));
+            let lp = Lp.solve(&problem).expect("lp");
             let (design, history) = Gradient::default()
                 .solve_with_history(&problem)
                 .expect("gradient");
             eprintln!(
-                "{:>7} {:>7} free  {:>2} programs + {:>2} corrections {:>4} interior iterations  J {:.12}  ratio {:.10}  {:?} {:.1} s {:?}",
+                "{:>7} {:>7} free  {:>2} programs + {:>2} corrections {:>4} interior iterations  J {:.12}  ratio {:.10}  {:?} {:.1} s ({:.1}× lp's {:.2} s) {:?}",
                 family.name(),
                 problem.structure().free_nodes().len(),
                 history.finish_steps,
@@ -256,6 +263,8 @@ fn finish_table() {
                 design.ratio,
                 design.termination,
                 design.time_s,
+                design.time_s / lp.time_s,
+                lp.time_s,
                 design.warnings
             );
         }
