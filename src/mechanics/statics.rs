@@ -261,9 +261,15 @@ impl Linearisation<'_> {
                     &ev.values
                 };
                 // The exact tangent keeps 1e-9 EA on slack cables: should it
-                // not factor, the iteration matrix does.
-                let Ok(factor) = system.factor(values).or_else(|_| system.factor(&ev.values))
-                else {
+                // not factor, the iteration matrix does (tried once: when
+                // `values` already is it, its failure is final).
+                let factored = system.factor(values);
+                let factored = if settled {
+                    factored.or_else(|_| system.factor(&ev.values))
+                } else {
+                    factored
+                };
+                let Ok(factor) = factored else {
                     return Ok(None);
                 };
                 refactorisations += 1;
