@@ -235,6 +235,8 @@ impl Linearisation<'_> {
         // roundoff, an increment need not shrink: on super-100m's design
         // that refactored at every iteration, 40 times).
         let (mut newton, mut polished) = (true, 0);
+        // Whether the last step was taken with a factor refactored for it.
+        let mut refactored = false;
         for iteration in 0..=settings.max_iterations {
             let converged = self.solver.converged(&ev, self.lambda, settings).1;
             if converged && (newton || polished == POLISHING_STEPS) {
@@ -243,16 +245,26 @@ impl Linearisation<'_> {
             if iteration == settings.max_iterations {
                 return Ok(converged.then_some((state, iteration)));
             }
-            let (mut delta, mut size) =
-                step(refreshed.as_ref().unwrap_or(&self.factor), &ev.residual);
+            let settled = slack_changed as f64
+                <= SETTLED_SLACK_CHANGE * slack.iter().filter(|&&s| s).count() as f64;
+            // A factor refactored for the last step, past which the slack
+            // cables have not settled, is not tried for a chord step: the
+            // tangent has changed by as many cables' stiffness as changed
+            // (each super-100m sample tried four such steps, every one
+            // refused, 0.07 s a solve).
+            let stale = refactored && !settled && !converged;
+            let (mut delta, mut size) = if stale {
+                (Vec::new(), f64::NAN)
+            } else {
+                step(refreshed.as_ref().unwrap_or(&self.factor), &ev.residual)
+            };
             newton = false;
+            refactored = false;
             polished += usize::from(converged);
             if !converged && (size.is_nan() || size > CHORD_CONTRACTION * previous) {
                 if refactorisations == CHORD_REFACTORISATIONS {
                     return Ok(None);
                 }
-                let settled = slack_changed as f64
-                    <= SETTLED_SLACK_CHANGE * slack.iter().filter(|&&s| s).count() as f64;
                 let exact;
                 let values = if settled {
                     exact = system.evaluate(changed, &state, self.lambda);
@@ -276,6 +288,7 @@ impl Linearisation<'_> {
                 (delta, size) = step(&factor, &ev.residual);
                 refreshed = Some(factor);
                 newton = true;
+                refactored = true;
             }
             if !size.is_finite() {
                 return Ok(None);
