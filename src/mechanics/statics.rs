@@ -172,8 +172,10 @@ impl Linearisation<'_> {
     /// state — numerically only, the symbolic analysis is `x*`'s, the
     /// structure being the same — and the iterations go on with it (Newton's
     /// where every step refactors), at most [`CHORD_REFACTORISATIONS`]
-    /// times. The refactored matrix keeps [`SLACK_ITERATION_RATIO`] of a
-    /// slack cable's axial stiffness: the exact tangent (1e-9 of it) throws
+    /// times; right after a refactorisation past which the slack cables
+    /// have not settled, without trying the chord step first (the tangent
+    /// has changed by every cable that changed). The refactored matrix
+    /// keeps [`SLACK_ITERATION_RATIO`] of a slack cable's axial stiffness: the exact tangent (1e-9 of it) throws
     /// a node held by slack cables far across their taut kink. Once the
     /// slack cables have settled — at most [`SETTLED_SLACK_CHANGE`] of them
     /// changed by the last step — the exact tangent is factored instead:
