@@ -175,8 +175,9 @@ impl Linearisation<'_> {
     /// times; right after a refactorisation past which the slack cables
     /// have not settled, without trying the chord step first (the tangent
     /// has changed by every cable that changed). The refactored matrix
-    /// keeps [`SLACK_ITERATION_RATIO`] of a slack cable's axial stiffness: the exact tangent (1e-9 of it) throws
-    /// a node held by slack cables far across their taut kink. Once the
+    /// keeps [`SLACK_ITERATION_RATIO`] of a slack cable's axial stiffness:
+    /// the exact tangent (1e-9 of it) throws a node held by slack cables
+    /// far across their taut kink. Once the
     /// slack cables have settled — at most [`SETTLED_SLACK_CHANGE`] of them
     /// changed by the last step — the exact tangent is factored instead:
     /// the kept stiffness, wrong by 1e-2 EA/L on every slack cable, makes
