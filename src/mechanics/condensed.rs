@@ -161,9 +161,8 @@ pub(crate) struct CondensedFactor {
     structure: Arc<Condensation>,
     /// `M`'s LDLᵀ values.
     l: Vec<f64>,
-    /// `Σ = L₂₂ Λ₂ L₂₂ᵀ`, `m × m`.
-    sigma: Mat<f64>,
-    /// `L₂₂`, unit lower triangular, and `Λ₂`: `Σ`'s factors.
+    /// `L₂₂`, unit lower triangular, and `Λ₂`: the factors of `M`'s Schur
+    /// complement on its last `m` rows, `Σ = L₂₂ Λ₂ L₂₂ᵀ`.
     l22: Mat<f64>,
     lambda2: Vec<f64>,
     s: Option<Lu>,
@@ -306,11 +305,11 @@ impl Condensation {
             )
             .map_err(CondensedError::Ldlt)?;
         let (l22, lambda2) = trailing_factor(&self.ldlt, &l, n_p, m);
-        let sigma = &Mat::from_fn(m, m, |i, j| l22[(i, j)] * lambda2[j]) * l22.transpose();
         let s = match &self.lu {
             None => None,
             Some(lu) => {
-                // −G = Σ + τI
+                // −G = Σ + τI, Σ = L₂₂ Λ₂ L₂₂ᵀ
+                let sigma = &Mat::from_fn(m, m, |i, j| l22[(i, j)] * lambda2[j]) * l22.transpose();
                 let mut minus_g: Vec<f64> = (0..m * m).map(|k| sigma[(k % m, k / m)]).collect();
                 for k in 0..m {
                     minus_g[k * m + k] += tau;
@@ -325,7 +324,6 @@ impl Condensation {
         Ok(CondensedFactor {
             structure: self.clone(),
             l,
-            sigma,
             l22,
             lambda2,
             s,
@@ -491,13 +489,13 @@ fn backward_sweep(factor: SupernodalLdltRef<'_, usize, f64>, mut x: MatMut<'_, f
 impl CondensedFactor {
     /// Solve `J Δ = rhs` in place (every column of `rhs`).
     ///
-    /// The two solves with `M` share their forward sweep: its first `n_p`
-    /// rows see `r_p` only, and its last `m` are `L₂₂⁻¹ (b₂ − L₂₁ y₁)`, so
-    /// the second right-hand side `(r_p, t)` sweeps to `y₂ + L₂₂⁻¹ t` from
-    /// the first's `(r_p, 0)`; and the first needs only the last `m` rows of
-    /// its solution, `L₂₂⁻ᵀ Λ₂⁻¹ y₂`. One forward and one backward sweep
-    /// through `L` then, not two of each (the solve reads the factor, 390 MB
-    /// at super-100m, once a sweep).
+    /// The two solves with `M` share their forward sweep `y = L⁻¹ P b`: its
+    /// first `n_p` rows see `r_p` only. The first needs only the last `m`
+    /// rows of its solution, `v = L₂₂⁻ᵀ Λ₂⁻¹ y₂`, whence `q = −Σ v = −L₂₂ y₂`;
+    /// the second's last `m` rows sweep to `y₂ + L₂₂⁻¹ (q + Σ δr) = Λ₂ L₂₂ᵀ
+    /// δr`. One forward and one backward sweep through `L` then, not two of
+    /// each (the solve reads the factor, 390 MB at super-100m, once a
+    /// sweep).
     pub(crate) fn solve_in_place(&self, mut rhs: MatMut<'_, f64>) {
         let structure = &*self.structure;
         let (par, k) = (structure.par, rhs.ncols());
@@ -509,7 +507,7 @@ impl CondensedFactor {
             .perm()
             .expect("the condensation's ordering is its own");
         let (order, _) = perm.arrays();
-        // 1. y = L⁻¹ P (r_p, 0); v = L₂₂⁻ᵀ Λ₂⁻¹ y₂; q = −Σ v
+        // 1. y = L⁻¹ P (r_p, 0); q = −Σ v = −L₂₂ y₂
         let mut y = Mat::from_fn(n_p + m, k, |i, j| {
             let row = order[i];
             if row < n_p {
@@ -519,14 +517,7 @@ impl CondensedFactor {
             }
         });
         forward_sweep(factor, y.as_mut(), par);
-        let y2 = y.subrows(n_p, m).to_owned();
-        let mut v = Mat::from_fn(m, k, |c, j| y2[(c, j)] / self.lambda2[c]);
-        triangular_solve::solve_unit_upper_triangular_in_place(
-            self.l22.transpose(),
-            v.as_mut(),
-            par,
-        );
-        let q = -(&self.sigma * &v);
+        let q = -(&self.l22 * y.subrows(n_p, m));
         // 2. δr = S⁻¹ (r_r − q)
         let mut r = Mat::from_fn(rest.len(), k, |i, j| rhs[(rest[i], j)]);
         for (c, &i) in coupled.iter().enumerate() {
@@ -537,12 +528,12 @@ impl CondensedFactor {
         if let Some(s) = &self.s {
             s.solve_in_place(r.as_mut());
         }
-        // 3. M (δp, w) = (r_p, t), t = q + Σ δr: y₂ ← y₂ + L₂₂⁻¹ t, then the
-        // backward sweep
+        // 3. M (δp, w) = (r_p, q + Σ δr): its forward sweep is y₁ and
+        // y₂ + L₂₂⁻¹ (q + Σ δr) = Λ₂ L₂₂ᵀ δr; then the backward sweep
         let dr = Mat::from_fn(m, k, |c, j| r[(coupled[c], j)]);
-        let mut t = &q + &self.sigma * &dr;
-        triangular_solve::solve_unit_lower_triangular_in_place(self.l22.as_ref(), t.as_mut(), par);
-        y.subrows_mut(n_p, m).copy_from(&(&y2 + &t));
+        let y2 = self.l22.transpose() * &dr;
+        y.subrows_mut(n_p, m)
+            .copy_from(Mat::from_fn(m, k, |c, j| self.lambda2[c] * y2[(c, j)]));
         backward_sweep(factor, y.as_mut(), par);
         for j in 0..k {
             for (i, &row) in order.iter().enumerate() {

@@ -256,43 +256,47 @@ impl Linearisation<'_> {
             // (each super-100m sample tried four such steps, every one
             // refused, 0.07 s a solve).
             let stale = refactored && !settled && !converged;
-            let (mut delta, mut size) = if stale {
-                (Vec::new(), f64::NAN)
-            } else {
-                step(refreshed.as_ref().unwrap_or(&self.factor), &ev.residual)
-            };
+            let chord =
+                (!stale).then(|| step(refreshed.as_ref().unwrap_or(&self.factor), &ev.residual));
             newton = false;
             refactored = false;
             polished += usize::from(converged);
-            if !converged && (size.is_nan() || size > CHORD_CONTRACTION * previous) {
-                if refactorisations == CHORD_REFACTORISATIONS {
-                    return Ok(None);
+            let contracts = chord
+                .as_ref()
+                .is_some_and(|&(_, size)| size <= CHORD_CONTRACTION * previous);
+            let (delta, size) = match chord {
+                Some(chord) if converged || contracts => chord,
+                _ => {
+                    if refactorisations == CHORD_REFACTORISATIONS {
+                        return Ok(None);
+                    }
+                    let exact;
+                    let values = if settled {
+                        exact = system.evaluate(changed, &state, self.lambda);
+                        &exact.values
+                    } else {
+                        &ev.values
+                    };
+                    // The exact tangent keeps 1e-9 EA on slack cables: should it
+                    // not factor, the iteration matrix does (tried once: when
+                    // `values` already is it, its failure is final).
+                    let factored = system.factor(values);
+                    let factored = if settled {
+                        factored.or_else(|_| system.factor(&ev.values))
+                    } else {
+                        factored
+                    };
+                    let Ok(factor) = factored else {
+                        return Ok(None);
+                    };
+                    refactorisations += 1;
+                    let newton_step = step(&factor, &ev.residual);
+                    refreshed = Some(factor);
+                    newton = true;
+                    refactored = true;
+                    newton_step
                 }
-                let exact;
-                let values = if settled {
-                    exact = system.evaluate(changed, &state, self.lambda);
-                    &exact.values
-                } else {
-                    &ev.values
-                };
-                // The exact tangent keeps 1e-9 EA on slack cables: should it
-                // not factor, the iteration matrix does (tried once: when
-                // `values` already is it, its failure is final).
-                let factored = system.factor(values);
-                let factored = if settled {
-                    factored.or_else(|_| system.factor(&ev.values))
-                } else {
-                    factored
-                };
-                let Ok(factor) = factored else {
-                    return Ok(None);
-                };
-                refactorisations += 1;
-                (delta, size) = step(&factor, &ev.residual);
-                refreshed = Some(factor);
-                newton = true;
-                refactored = true;
-            }
+            };
             if !size.is_finite() {
                 return Ok(None);
             }
