@@ -65,8 +65,8 @@ fn the_sector_grid_matches_clarabel() {
 }
 
 /// Issue 38's target (≤ 20 iterations) is not reached on this family yet:
-/// 30 at 463 free nodes, 33 at 10³ and 64 at 10⁴ (from 42 and 77 with the
-/// unscaled start). The bound holds today's count so that a regression fails.
+/// 25 at 463 free nodes, 33 at 10³ and 68 at 10⁴ (clarabel takes 66 on the
+/// same LP there). The bound holds today's count so that a regression fails.
 #[test]
 fn the_jittered_grid_matches_clarabel() {
     let iterations = matches_clarabel(Family::Jitter, 12);
@@ -74,12 +74,13 @@ fn the_jittered_grid_matches_clarabel() {
 }
 
 /// The iteration count per family at the largest size CI affords (28 rows,
-/// 2 431 free net nodes; about 1 s per family): measured 17 (hex), 13
-/// (sector) and 42 (jitter) with the plan settings of this commit; each bound
-/// leaves 3–6 iterations of margin, so a change to the driver, the start or
-/// the step rule that costs iterations on any family fails here. (At 10⁴ free
-/// nodes the same method takes 24, 16 and 64; at 10⁵ the jittered net needs
-/// more than 100.)
+/// 2 431 free net nodes; about 1 s per family): measured 19 (hex), 15
+/// (sector) and 44 (jitter) with the plan settings of this commit (17, 13 and
+/// 42 with a predictor completed by FGMRES and no least centring, which took
+/// more time: `IpmSettings::plan`); each bound leaves 1–4 iterations of
+/// margin, so a change to the driver, the start or the step rule that costs
+/// iterations on any family fails here. (At 10⁴ free nodes the same method
+/// takes 25, 18 and 68; at 10⁵ the jittered net needs more than 100.)
 #[test]
 fn iterations_stay_within_their_bounds_at_2431_free_nodes() {
     for (family, bound) in [

@@ -152,10 +152,11 @@ impl Program {
     /// (`dx, dw | dz, dλ | ds | dy`): the reduction
     /// ([`Program::direction_once`]) as a right preconditioner of FGMRES on
     /// the rows it solves only up to the factor's regularisation. FGMRES
-    /// stops at [`IpmSettings::krylov_tolerance`] of those rows' right-hand
-    /// side or at `floor`, whichever is larger (an absolute 2-norm); returns
-    /// the direction and the 2-norm of its residual in those rows (0 where
-    /// the reduction is taken as it is).
+    /// takes at most `steps` steps and stops at
+    /// [`IpmSettings::krylov_tolerance`] of those rows' right-hand side or at
+    /// `floor`, whichever is larger (an absolute 2-norm); returns the
+    /// direction and the 2-norm of its residual in those rows (0 where the
+    /// reduction is taken as it is: `steps` 0, or the 3-D problem).
     ///
     /// [`IpmSettings::krylov_tolerance`]: super::settings::IpmSettings::krylov_tolerance
     #[allow(clippy::too_many_arguments)]
@@ -169,6 +170,7 @@ impl Program {
         lam: &[f64],
         rhs: &Rhs,
         floor: f64,
+        steps: usize,
     ) -> (Point, f64) {
         let (m, p, n) = (self.m, self.set.len(), normal.n_rows);
         let mut d = self.direction_once(normal, sc, x, z, w, lam, rhs);
@@ -176,7 +178,7 @@ impl Program {
         // rows (mechanisms), FGMRES makes the small test scenes stall at
         // reduced accuracy; there the reduction alone converges. The plan
         // problem (D = 2, a triangulated plan net) is where FGMRES is needed.
-        if D == 3 {
+        if D == 3 || steps == 0 {
             return (d, 0.0);
         }
         // Rows the reduction solves only up to the factor's regularisation:
@@ -208,7 +210,7 @@ impl Program {
         let mut g = vec![beta];
         let mut residual = beta;
         let mut rw = vec![0.0; p];
-        for it in 0..self.settings.krylov_steps {
+        for it in 0..steps {
             let v = &basis[it];
             rw.iter_mut().zip(&v[n..n + p]).for_each(|(a, b)| *a = -b);
             let zj = self.direction_once(

@@ -176,7 +176,7 @@ pub(crate) fn run<S: NewtonSystem>(system: &mut S, settings: &IpmSettings) -> Ou
         let (ap, ad) = steps(&point, &affine);
         let (dv, du) = (&affine.primal, &affine.dual);
         let mu_aff = pair_sum(&ends, |i| (v[i] + ap * dv[i]) * (u[i] + ad * du[i])) / n_compl;
-        let sigma = (mu_aff / mu).powi(3).clamp(0.0, 1.0);
+        let sigma = (mu_aff / mu).powi(3).clamp(settings.min_centring, 1.0);
 
         // Corrector.
         let r: Vec<f64> = (0..n_pairs)

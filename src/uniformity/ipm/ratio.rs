@@ -359,6 +359,12 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
         } else {
             0.0
         };
+        let settings = &program.settings;
+        let steps = if rhs == Rhs::Predictor {
+            settings.predictor_krylov_steps
+        } else {
+            settings.krylov_steps
+        };
         let (d, residual) = program.direction(
             &mut self.normal,
             sc,
@@ -375,6 +381,7 @@ impl<const D: usize> NewtonSystem for LpSystem<'_, D> {
                 rwl,
             },
             floor,
+            steps,
         );
         if rhs == Rhs::Corrector {
             self.corrector_residual = residual;

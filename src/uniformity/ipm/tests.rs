@@ -121,6 +121,13 @@ fn settings_out_of_range_are_named() {
             },
             "stall_iterations",
         ),
+        (
+            IpmSettings {
+                min_centring: f64::NAN,
+                ..IpmSettings::default()
+            },
+            "min_centring",
+        ),
     ] {
         match solve(&full_lp(&problem), &settings, None) {
             Err(IpmError::Setting { name: found, .. }) => assert_eq!(found, name),
@@ -128,6 +135,7 @@ fn settings_out_of_range_are_named() {
         }
     }
     assert!(IpmSettings::default().validate().is_ok());
+    assert!(IpmSettings::plan().validate().is_ok());
 }
 
 /// `Tmax/Tmin` of a ratio LP's set for its (unscaled) `q`.
