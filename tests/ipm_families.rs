@@ -65,7 +65,7 @@ fn the_sector_grid_matches_clarabel() {
 }
 
 /// Issue 38's target (≤ 20 iterations) is not reached on this family yet:
-/// 25 at 463 free nodes, 33 at 10³ and 68 at 10⁴ (clarabel takes 66 on the
+/// 24 at 463 free nodes, 33 at 10³ and 65 at 10⁴ (clarabel takes 66 on the
 /// same LP there). The bound holds today's count so that a regression fails.
 #[test]
 fn the_jittered_grid_matches_clarabel() {
@@ -74,13 +74,13 @@ fn the_jittered_grid_matches_clarabel() {
 }
 
 /// The iteration count per family at the largest size CI affords (28 rows,
-/// 2 431 free net nodes; about 1 s per family): measured 19 (hex), 15
-/// (sector) and 44 (jitter) with the plan settings of this commit (17, 13 and
+/// 2 431 free net nodes; about 1 s per family): measured 18 (hex), 15
+/// (sector) and 43 (jitter) with the plan settings of this commit (17, 13 and
 /// 42 with a predictor completed by FGMRES and no least centring, which took
-/// more time: `IpmSettings::plan`); each bound leaves 1–4 iterations of
+/// more time: `IpmSettings::plan`); each bound leaves 1–5 iterations of
 /// margin, so a change to the driver, the start or the step rule that costs
 /// iterations on any family fails here. (At 10⁴ free nodes the same method
-/// takes 25, 18 and 68; at 10⁵ the jittered net needs more than 100.)
+/// takes 23, 18 and 65; at 10⁵ 39, 28 and 139.)
 #[test]
 fn iterations_stay_within_their_bounds_at_2431_free_nodes() {
     for (family, bound) in [

@@ -16,6 +16,7 @@ free="${1:-1000,10000}"
 csv="${2:-results/bench/side-by-side.csv}"
 mkdir -p "$(dirname "$csv")"
 echo "load before: $(uptime)"
-RINGMESH_SIDE_FREE="$free" RINGMESH_SIDE_CSV="$PWD/$csv" \
+case "$csv" in /*) ;; *) csv="$PWD/$csv" ;; esac
+RINGMESH_SIDE_FREE="$free" RINGMESH_SIDE_CSV="$csv" \
     cargo bench --bench side_by_side
 echo "load after: $(uptime)"

@@ -109,14 +109,49 @@ impl Program {
             .fold(0.0, f64::max)
     }
 
-    /// Projects `q` onto `A q = 0` in the metric of relative changes:
-    /// `q ← q − W Aᵀ (A W Aᵀ)⁻¹ A q`, `W = diag(q²)`, so every cable moves by
-    /// about the residual relative to its own force density (cables at a bound
-    /// stay there to that order). Returns `q` and its relative residual.
-    fn polish<const D: usize>(
+    /// Projects `q` onto `A q = 0`, first holding the cables at a bound
+    /// (within [`POLISH_BOUND`] of their floor or, on the set, of the largest
+    /// set tension: [`Program::polish_with`] with their weights scaled by
+    /// [`POLISH_HELD`]), else, where the other cables cannot take up the
+    /// residual, moving every cable. Returns `q` and its relative residual.
+    ///
+    /// The cables at the bounds carry the ratio: moved by the residual, they
+    /// move it by as much. On the hexagonal net at 99 913 free nodes the
+    /// iterate's primal residual ends at 6.9e-9 of the largest tension (776,
+    /// so 5e-6 of the floor's); the projection moving every cable put the
+    /// ratio 1.1e-6 above clarabel's, holding the bounds 2.7e-7.
+    fn polish<const D: usize>(&self, normal: &mut NormalMatrix<D>, q: Vec<f64>) -> (Vec<f64>, f64) {
+        let max_set_tension = self
+            .set
+            .iter()
+            .map(|&k| self.lengths[k] * q[k])
+            .fold(0.0, f64::max);
+        let held: Vec<bool> = (0..self.m)
+            .map(|k| {
+                let above_floor = q[k] - self.lower[k];
+                let below_top = match self.in_set[k] {
+                    NONE => f64::INFINITY,
+                    _ => max_set_tension - self.lengths[k] * q[k],
+                };
+                above_floor <= POLISH_BOUND * q[k] || below_top <= POLISH_BOUND * max_set_tension
+            })
+            .collect();
+        let (held_q, primal) = self.polish_with(normal, q.clone(), &held);
+        if primal <= self.settings.polished {
+            return (held_q, primal);
+        }
+        self.polish_with(normal, q, &vec![false; self.m])
+    }
+
+    /// `q ← q − W Aᵀ (A W Aᵀ)⁻¹ A q` (twice at most), `W = diag(q²)` scaled
+    /// by [`POLISH_HELD`] where `held`: every other cable moves by about the
+    /// residual relative to its own force density. Returns `q` and its
+    /// residual relative to the largest tension.
+    fn polish_with<const D: usize>(
         &self,
         normal: &mut NormalMatrix<D>,
         mut q: Vec<f64>,
+        held: &[bool],
     ) -> (Vec<f64>, f64) {
         let max_tension = q
             .iter()
@@ -126,7 +161,11 @@ impl Program {
         let n = normal.n_rows;
         let mut residual = vec![0.0; n];
         let mut correction = vec![0.0; self.m];
-        let weights: Vec<f64> = q.iter().map(|v| v * v).collect();
+        let weights: Vec<f64> = q
+            .iter()
+            .zip(held)
+            .map(|(v, &h)| if h { POLISH_HELD * v * v } else { v * v })
+            .collect();
         if normal.factorize(&weights).is_err() {
             return (q, f64::INFINITY);
         }
@@ -145,6 +184,13 @@ impl Program {
         (q, norm_inf(&residual) / max_tension)
     }
 }
+
+/// A cable within this fraction of a bound is held by the final projection
+/// ([`Program::polish`]).
+const POLISH_BOUND: f64 = 1e-4;
+
+/// The factor of a held cable's weight in the final projection.
+const POLISH_HELD: f64 = 1e-8;
 
 /// The ratio LP in the driver's form: pairs `(x, z)` per cable, then
 /// `(w, λ)` per set cable; the ratio `s` takes the primal step, `y` the

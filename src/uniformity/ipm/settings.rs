@@ -184,7 +184,7 @@ impl Default for IpmSettings {
 
 impl IpmSettings {
     /// The settings of the plan problem of a tied net (`D = 2`, see
-    /// `uniformity/plan.rs`): a static shift of 1e-12 of the unit diagonal and
+    /// `uniformity/plan.rs`): a static shift of 1e-13 of the unit diagonal and
     /// no dropped pivots. The plan equilibrium matrix of a triangulated net has
     /// independent rows, so a tiny pivot is never a mechanism: it is a
     /// direction that the optimum's degenerate face leaves to the border `a`
@@ -196,7 +196,15 @@ impl IpmSettings {
     /// method stalled (2·10³ nodes), failed to factor (2·10⁴) or gave up
     /// (2·10⁵). With the shift the border's elimination stays consistent and
     /// the method converges on all of them (shift 1e-10 already leaves too
-    /// many directions damped at 2·10⁵ nodes for FGMRES to restore).
+    /// many directions damped at 2·10⁵ nodes for FGMRES to restore). The
+    /// shift was 1e-12: at 99 913 free nodes the primal residual then stalled
+    /// at 2.6e-8 of the largest tension on the hexagonal net (FGMRES at its
+    /// step limit) and the projection onto equilibrium put the ratio 5.1e-6
+    /// above clarabel's; with 1e-13, 6.9e-9 and 2.7e-7 (`Program::polish`),
+    /// in 28.7 s against 30.5 s. A shift of 1e-14 stalled at 3.0e-9, but
+    /// the 120-bay ring of `tests/super_large.rs` then assembled with a
+    /// largest tension change of 0.054 % against 0.0014 % (1e-12) and
+    /// 0.00074 % (1e-13).
     ///
     /// Its start is [`Start::TensionScaled`]: on the three net families of
     /// issue 38 it saved 1–13 of 21–77 iterations in five of six nets at
@@ -243,7 +251,7 @@ impl IpmSettings {
     /// and sector (0.61, 0.77 s).
     pub(crate) fn plan() -> Self {
         IpmSettings {
-            regularization: 1e-12,
+            regularization: 1e-13,
             pivot_epsilon: 1e-30,
             predictor_krylov_steps: 0,
             min_centring: 0.03,
