@@ -25,18 +25,23 @@ impl UniformitySet {
     /// `Tmax/Tmin` of `tensions_n` (all cables) over the set's cables:
     /// infinite when one of them is slack (`T ≤ 0`).
     pub fn ratio(&self, tensions_n: &[f64]) -> f64 {
-        let (lo, hi) = self
-            .edges
-            .iter()
-            .map(|&k| tensions_n[k])
-            .fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
-                (lo.min(t), hi.max(t))
-            });
-        if lo > 0.0 {
-            hi / lo
-        } else {
-            f64::INFINITY
-        }
+        ratio_over(&self.edges, |k| tensions_n[k])
+    }
+}
+
+/// `Tmax/Tmin` over `cables` of the tensions `tension(k)`: infinite when
+/// one of them is slack (`T ≤ 0`).
+pub(crate) fn ratio_over(cables: &[usize], tension: impl Fn(usize) -> f64) -> f64 {
+    let (lo, hi) = cables
+        .iter()
+        .map(|&k| tension(k))
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
+            (lo.min(t), hi.max(t))
+        });
+    if lo > 0.0 {
+        hi / lo
+    } else {
+        f64::INFINITY
     }
 }
 

@@ -14,6 +14,7 @@ use super::system::{Measures, NewtonSystem, Point, Rhs};
 use crate::algebra::{dot, norm_inf};
 use crate::fdm::NONE;
 use crate::status::Termination;
+use crate::uniformity::problem::ratio_over;
 
 /// Solves the ratio LP with the structured interior-point method and
 /// `settings`, from `start`'s iterate when it has one of an LP of the same
@@ -155,7 +156,10 @@ impl Program {
         };
         let polished = |p: &(Vec<f64>, f64)| p.1 <= self.settings.polished;
         let better = match (polished(&moving_all), polished(&holding)) {
-            (true, true) => self.set_ratio(&holding.0) < self.set_ratio(&moving_all.0),
+            (true, true) => {
+                let ratio = |q: &[f64]| ratio_over(&self.set, |k| self.lengths[k] * q[k]);
+                ratio(&holding.0) < ratio(&moving_all.0)
+            }
             (false, true) => true,
             (true, false) => false,
             (false, false) => holding.1 < moving_all.1,
@@ -164,23 +168,6 @@ impl Program {
             holding
         } else {
             moving_all
-        }
-    }
-
-    /// `Tmax/Tmin` over the set for `q`; infinite where a set tension is not
-    /// positive.
-    fn set_ratio(&self, q: &[f64]) -> f64 {
-        let (min, max) = self
-            .set
-            .iter()
-            .map(|&k| self.lengths[k] * q[k])
-            .fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
-                (lo.min(t), hi.max(t))
-            });
-        if min > 0.0 {
-            max / min
-        } else {
-            f64::INFINITY
         }
     }
 
