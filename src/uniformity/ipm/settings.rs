@@ -200,8 +200,9 @@ impl IpmSettings {
     /// shift was 1e-12: at 99 913 free nodes the primal residual then stalled
     /// at 2.6e-8 of the largest tension on the hexagonal net (FGMRES at its
     /// step limit) and the projection onto equilibrium put the ratio 5.1e-6
-    /// above clarabel's; with 1e-13, 6.9e-9 and 2.7e-7 (`Program::polish`),
-    /// in 28.7 s against 30.5 s. A shift of 1e-14 stalled at 3.0e-9, but
+    /// above clarabel's; with 1e-13, 6.9e-9 and, with `Program::polish`'s
+    /// choice of projection, 5.2e-7 (the jittered net 3.7e-6, still outside
+    /// 1e-6), in 28.2–28.7 s against 30.5 s. A shift of 1e-14 stalled at 3.0e-9, but
     /// the 120-bay ring of `tests/super_large.rs` then assembled with a
     /// largest tension change of 0.054 % against 0.0014 % (1e-12) and
     /// 0.00074 % (1e-13).
@@ -211,8 +212,8 @@ impl IpmSettings {
     /// 10³/10⁴ free nodes (one more on the regular sector grid at 10⁴).
     ///
     /// Its iteration limit is 200: the jittered sector grid of issue 38
-    /// (`tests/common/nets.rs`) takes 33, 42, 64 iterations at 10³, 2.4·10³,
-    /// 10⁴ free nodes and 134 at 10⁵ (converged; the gap still fell by about
+    /// (`tests/common/nets.rs`) takes 33, 43, 65 iterations at 10³, 2.4·10³,
+    /// 10⁴ free nodes and 137 at 10⁵ (converged; the gap still fell by about
     /// 0.8 per iteration at the default limit of 100, 2·10⁻⁶ there, so the
     /// run ended in `MaxIterations` and the route fell back to clarabel,
     /// which needs minutes at that size).
@@ -243,7 +244,8 @@ impl IpmSettings {
     /// Its least centring is 0.03: on the hexagonal net at 9 913 free nodes
     /// one predictor reached 0.96 of the way with `σ = 7·10⁻⁵`, `μ` fell 50×
     /// in one iteration, and the next 6–8 iterations took steps of 0.02–0.6
-    /// at a gap of 1e-3 to recentre. With both changes (same runs as above):
+    /// at a gap of 1e-3 to recentre. With both changes (two rounds
+    /// interleaved, best of 3, the machine quieter):
     /// hex 1.19–1.20 → 0.87–0.90 s (24 → 25 iterations), sector 0.58–0.59 →
     /// 0.54–0.57 s (16 → 18), jitter 2.73–2.80 → 2.24–2.27 s (64 → 68); at
     /// 1 021 free nodes hex and sector unchanged (0.06 and 0.05 s), jitter
