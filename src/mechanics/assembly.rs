@@ -25,6 +25,7 @@ use faer::{Mat, MatMut};
 use rayon::prelude::*;
 
 use super::cable::SLACK_STIFFNESS_RATIO;
+pub(crate) use super::condensed::Precision;
 use super::condensed::{Condensation, CondensedError, CondensedFactor};
 use super::joint::ConstraintRow;
 use super::model::{MechanicsError, Model};
@@ -475,6 +476,19 @@ impl System {
     /// A singular tangent: for the dense factor, a pivot below `n ε ‖J‖max`,
     /// the roundoff of a zero pivot (a mechanism).
     pub fn factor(&self, values: &[f64]) -> Result<Factor, FactorError> {
+        self.factor_in(values, Precision::Double)
+    }
+
+    /// [`System::factor`] with the cable net's LDLᵀ in `precision` where
+    /// the tangent is condensed (the dense and sparse LU are double).
+    ///
+    /// # Errors
+    /// As [`System::factor`].
+    pub(crate) fn factor_in(
+        &self,
+        values: &[f64],
+        precision: Precision,
+    ) -> Result<Factor, FactorError> {
         let count = values.iter().filter(|v| !v.is_finite()).count();
         if count > 0 {
             return Err(FactorError::NotFinite { count });
@@ -499,7 +513,9 @@ impl System {
             return Ok(Factor::Dense(lu));
         }
         let lu = match &self.sparse {
-            SparseFactorisation::Condensed(c) => return Ok(Factor::Condensed(c.factor(values)?)),
+            SparseFactorisation::Condensed(c) => {
+                return Ok(Factor::Condensed(c.factor(values, precision)?))
+            }
             SparseFactorisation::Lu(lu) => lu,
         };
         let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)

@@ -8,7 +8,7 @@
 //! silently wrong state.
 
 use super::arc_length;
-use super::assembly::{Evaluation, Factor, State, System};
+use super::assembly::{Evaluation, Factor, Precision, State, System};
 use super::load_control;
 use super::model::MechanicsError;
 use super::model::Model;
@@ -174,7 +174,13 @@ impl Linearisation<'_> {
     /// where every step refactors), at most [`CHORD_REFACTORISATIONS`]
     /// times; right after a refactorisation past which the slack cables
     /// have not settled, without trying the chord step first (the tangent
-    /// has changed by every cable that changed). The refactored matrix
+    /// has changed by every cable that changed). The net's LDLᵀ of a
+    /// refactorisation is single precision: the residual is double and
+    /// the factor only sets the steps, so the equilibrium is the same. (Eight
+    /// super-100m tolerance samples, two threads: the same iterations and
+    /// refactorisations, 8–14 each, as in double, and 46.7 s against 76.4
+    /// s — the two samples' factorisations beside each other are bound by
+    /// memory, which single precision halves.) The refactored matrix
     /// keeps [`SLACK_ITERATION_RATIO`] of a slack cable's axial stiffness:
     /// the exact tangent (1e-9 of it) throws a node held by slack cables
     /// far across their taut kink. Once the
@@ -278,14 +284,16 @@ impl Linearisation<'_> {
                         &ev.values
                     };
                     // The exact tangent keeps 1e-9 EA on slack cables: should it
-                    // not factor, the iteration matrix does (tried once: when
-                    // `values` already is it, its failure is final).
-                    let factored = system.factor(values);
+                    // not factor, the iteration matrix does; should that not
+                    // factor in single precision, in double (its pivots below
+                    // f32's roundoff, or beyond its range).
+                    let factored = system.factor_in(values, Precision::Single);
                     let factored = if settled {
-                        factored.or_else(|_| system.factor(&ev.values))
+                        factored.or_else(|_| system.factor_in(&ev.values, Precision::Single))
                     } else {
                         factored
                     };
+                    let factored = factored.or_else(|_| system.factor(&ev.values));
                     let Ok(factor) = factored else {
                         return Ok(None);
                     };
