@@ -55,7 +55,7 @@ use faer::sparse::linalg::cholesky::{
     SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Accum, Mat, MatMut, Par, Side};
 
 /// The parallelism of the net's LDLᵀ and its solves: one thread, as the
@@ -208,6 +208,10 @@ impl Real for f32 {
     }
 }
 
+/// `L₂₂` (unit lower triangular) and `Λ₂`, the factors of `M`'s Schur
+/// complement on its last `m` rows, `Σ = L₂₂ Λ₂ L₂₂ᵀ`.
+type Trailing = (Mat<f64>, Vec<f64>);
+
 /// A condensed factor of one tangent.
 pub(crate) struct CondensedFactor {
     structure: Arc<Condensation>,
@@ -331,7 +335,6 @@ impl Condensation {
         values: &[f64],
         precision: Precision,
     ) -> Result<CondensedFactor, CondensedError> {
-        let n_p = self.points.len();
         let m = self.coupled.len();
         let tau = self
             .diagonal
@@ -339,24 +342,16 @@ impl Condensation {
             .map(|&p| values[p].abs())
             .fold(f64::MIN_POSITIVE, f64::max);
         let matrix = self.m.matrix(values, tau, &[])?;
-        let (l, (l22, lambda2)) = match precision {
+        let (l, l22, lambda2) = match precision {
             Precision::Double => {
-                let l = self.ldlt_values(matrix.as_ref())?;
-                let trailing = trailing_factor(&self.ldlt, &l, n_p, m);
-                (Values::Double(l), trailing)
+                let (l, (l22, lambda2)) = self.numeric(matrix.as_ref())?;
+                (Values::Double(l), l22, lambda2)
             }
             Precision::Single => {
                 let single: Vec<f32> = matrix.val().iter().map(|&v| f32::of(v)).collect();
-                let matrix = SparseColMat::new(
-                    matrix
-                        .symbolic()
-                        .to_owned()
-                        .map_err(CondensedError::SparseMatrix)?,
-                    single,
-                );
-                let l = self.ldlt_values(matrix.as_ref())?;
-                let trailing = trailing_factor(&self.ldlt, &l, n_p, m);
-                (Values::Single(l), trailing)
+                let single = SparseColMatRef::new(matrix.symbolic(), &single);
+                let (l, (l22, lambda2)) = self.numeric(single)?;
+                (Values::Single(l), l22, lambda2)
             }
         };
         let s = match &self.lu {
@@ -384,11 +379,12 @@ impl Condensation {
         })
     }
 
-    /// The values of `matrix`'s (`M`'s) LDLᵀ in its symbolic factorisation.
-    fn ldlt_values<T: Real>(
+    /// `matrix`'s (`M`'s) LDLᵀ values in its symbolic factorisation, and
+    /// the factors `L₂₂`, `Λ₂` of its trailing Schur complement.
+    fn numeric<T: Real>(
         &self,
-        matrix: faer::sparse::SparseColMatRef<'_, usize, T>,
-    ) -> Result<Vec<T>, CondensedError> {
+        matrix: SparseColMatRef<'_, usize, T>,
+    ) -> Result<(Vec<T>, Trailing), CondensedError> {
         let par = self.par;
         let mut l = vec![T::default(); self.ldlt.len_val()];
         let mut buffer = MemBuffer::try_new(
@@ -407,7 +403,8 @@ impl Condensation {
                 Default::default(),
             )
             .map_err(CondensedError::Ldlt)?;
-        Ok(l)
+        let trailing = trailing_factor(&self.ldlt, &l, self.points.len(), self.coupled.len());
+        Ok((l, trailing))
     }
 }
 
@@ -460,7 +457,7 @@ fn trailing_factor<T: Real>(
     l: &[T],
     n_p: usize,
     m: usize,
-) -> (Mat<f64>, Vec<f64>) {
+) -> Trailing {
     let mut l22 = Mat::<f64>::zeros(m, m);
     let mut lambda = vec![0.0; m];
     let factor = supernodal(symbolic, l);
