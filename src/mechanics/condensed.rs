@@ -174,21 +174,12 @@ enum Values {
 }
 
 /// A real type the net's LDLᵀ can be computed in.
-trait Real:
-    faer::traits::RealField
-    + Copy
-    + std::ops::SubAssign
-    + std::ops::DivAssign
-    + std::ops::Neg<Output = Self>
-    + Default
-{
-    const ONE: Self;
+trait Real: faer::traits::RealField + Copy {
     fn of(x: f64) -> Self;
     fn to(self) -> f64;
 }
 
 impl Real for f64 {
-    const ONE: Self = 1.0;
     fn of(x: f64) -> Self {
         x
     }
@@ -198,7 +189,6 @@ impl Real for f64 {
 }
 
 impl Real for f32 {
-    const ONE: Self = 1.0;
     #[allow(clippy::cast_possible_truncation)]
     fn of(x: f64) -> Self {
         x as f32
@@ -386,7 +376,7 @@ impl Condensation {
         matrix: SparseColMatRef<'_, usize, T>,
     ) -> Result<(Vec<T>, Trailing), CondensedError> {
         let par = self.par;
-        let mut l = vec![T::default(); self.ldlt.len_val()];
+        let mut l = vec![T::zero(); self.ldlt.len_val()];
         let mut buffer = MemBuffer::try_new(
             self.ldlt
                 .factorize_numeric_ldlt_scratch::<T>(par, Default::default()),
@@ -521,7 +511,7 @@ fn forward_sweep<T: Real>(factor: SupernodalLdltRef<'_, usize, T>, mut x: MatMut
             Accum::Replace,
             bottom,
             x_top.rb(),
-            T::ONE,
+            T::one(),
             par,
         );
         for j in 0..k {
@@ -560,7 +550,7 @@ fn backward_sweep<T: Real>(
             Accum::Add,
             bottom.transpose(),
             below.rb(),
-            -T::ONE,
+            -T::one(),
             par,
         );
         triangular_solve::solve_unit_upper_triangular_in_place(top.transpose(), x_top, par);
@@ -603,7 +593,7 @@ impl CondensedFactor {
             if row < n_p {
                 T::of(rhs[(points[row], j)])
             } else {
-                T::default()
+                T::zero()
             }
         });
         forward_sweep(factor, y.as_mut(), par);

@@ -140,8 +140,9 @@ impl Program {
         // is 1e-15 of the largest tension): no projection, no factorisation.
         let mut residual = vec![0.0; normal.n_rows];
         normal.a_mul(&q, &mut residual);
-        if norm_inf(&residual) <= 0.1 * self.settings.polished * max_tension {
-            return (q, norm_inf(&residual) / max_tension);
+        let r = norm_inf(&residual);
+        if r <= 0.1 * self.settings.polished * max_tension {
+            return (q, r / max_tension);
         }
         let max_set_tension = self
             .set
