@@ -98,7 +98,7 @@ pub(super) fn follow_observed(
         let mut iterations = 0;
         for it in 0..=settings.max_iterations {
             let ev = system.evaluate(solver.model(), &trial, trial_lambda);
-            let (force, ok) = solver.converged(&ev, trial_lambda, settings);
+            let (force, ok) = solver.converged(&ev.forces, trial_lambda, settings);
             residuals.push(force);
             iterations = it;
             if !force.is_finite() {
@@ -106,7 +106,7 @@ pub(super) fn follow_observed(
             }
             if ok {
                 converged = true;
-                reactions = ev.reactions;
+                reactions = ev.forces.reactions;
                 break;
             }
             if it == settings.max_iterations {
@@ -115,8 +115,13 @@ pub(super) fn follow_observed(
             let Ok(lu) = system.factor(&ev.values) else {
                 break;
             };
-            let mut rhs =
-                Mat::from_fn(n, 2, |i, j| if j == 0 { -ev.residual[i] } else { f_hat[i] });
+            let mut rhs = Mat::from_fn(n, 2, |i, j| {
+                if j == 0 {
+                    -ev.forces.residual[i]
+                } else {
+                    f_hat[i]
+                }
+            });
             System::solve_in_place(&lu, rhs.as_mut());
             let du_f: Vec<f64> = (0..n).map(|i| rhs[(i, 0)]).collect();
             let du_t: Vec<f64> = (0..n).map(|i| rhs[(i, 1)]).collect();

@@ -184,12 +184,11 @@ impl State {
     }
 }
 
-/// Residual and tangent values at a state.
-pub(crate) struct Evaluation {
+/// Residual and support reactions at a state, without the tangent: what a
+/// step's line search and convergence tests read.
+pub(crate) struct Forces {
     /// Residual of every unknown (forces, moments, joint equations).
     pub residual: Vec<f64>,
-    /// Tangent values in pattern order.
-    pub values: Vec<f64>,
     /// Residual of every fixed component: the support reactions, per node.
     pub reactions: Vec<[f64; 6]>,
     /// Largest internal nodal force component of any element or cable
@@ -198,6 +197,14 @@ pub(crate) struct Evaluation {
     /// Largest force component of any cable: the force scale of a prestressed
     /// structure with no external load.
     pub prestress_scale: f64,
+}
+
+/// Residual and tangent values at a state.
+pub(crate) struct Evaluation {
+    /// The residual and reactions.
+    pub forces: Forces,
+    /// Tangent values in pattern order.
+    pub values: Vec<f64>,
 }
 
 impl System {
@@ -341,9 +348,52 @@ impl System {
         lambda: f64,
         slack_tangent_ratio: f64,
     ) -> Evaluation {
+        let mut values = Vec::new();
+        let forces = self.assemble(
+            model,
+            state,
+            lambda,
+            Some((slack_tangent_ratio, &mut values)),
+        );
+        Evaluation { forces, values }
+    }
+
+    /// The residual and reactions at `state` and load factor `lambda`
+    /// alone: [`System::evaluate`] without assembling the tangent.
+    pub(crate) fn forces(&self, model: &Model, state: &State, lambda: f64) -> Forces {
+        self.assemble(model, state, lambda, None)
+    }
+
+    /// The tangent values of [`System::evaluate_with`] into `values`
+    /// (cleared first, its allocation reused: at 10⁵ nodes the values are
+    /// ≈ 80 MB, and a fresh buffer's first touch of each page cost as much
+    /// as filling it).
+    pub(crate) fn tangent_into(
+        &self,
+        model: &Model,
+        state: &State,
+        lambda: f64,
+        slack_tangent_ratio: f64,
+        values: &mut Vec<f64>,
+    ) {
+        self.assemble(model, state, lambda, Some((slack_tangent_ratio, values)));
+    }
+
+    /// The residual and reactions, and the tangent values into `tangent`'s
+    /// buffer where asked for (slack cables keeping its ratio of EA).
+    fn assemble(
+        &self,
+        model: &Model,
+        state: &State,
+        lambda: f64,
+        mut tangent: Option<(f64, &mut Vec<f64>)>,
+    ) -> Forces {
         let n_nodes = model.node_count();
         let mut full = vec![[0.0f64; 6]; n_nodes];
-        let mut values = Vec::with_capacity(self.pattern.len());
+        if let Some((_, values)) = tangent.as_mut() {
+            values.clear();
+            values.reserve(self.pattern.len());
+        }
         let element = |e: &super::beam::BeamElement| {
             let [a, b] = e.nodes;
             e.residual_tangent([&state.frames[a], &state.frames[b]])
@@ -361,6 +411,9 @@ impl System {
                     full[n][c] += r[6 * slot + c];
                 }
             }
+            let Some((_, values)) = tangent.as_mut() else {
+                continue;
+            };
             for sa in 0..2 {
                 for sb in 0..2 {
                     let (a, b) = (e.nodes[sa], e.nodes[sb]);
@@ -376,17 +429,22 @@ impl System {
         let mut prestress_scale = 0.0f64;
         for c in &model.cables {
             let [a, b] = c.nodes;
-            let (f, k) = c.force_tangent(
-                &state.frames[a].position_m,
-                &state.frames[b].position_m,
-                lambda,
-                slack_tangent_ratio,
-            );
+            let (pa, pb) = (&state.frames[a].position_m, &state.frames[b].position_m);
+            let (f, k) = match tangent.as_mut() {
+                Some((ratio, _)) => {
+                    let (f, k) = c.force_tangent(pa, pb, lambda, *ratio);
+                    (f, Some(k))
+                }
+                None => (c.force(pa, pb, lambda), None),
+            };
             prestress_scale = prestress_scale.max(f.amax());
             for comp in 0..3 {
                 full[a][comp] -= f[comp];
                 full[b][comp] += f[comp];
             }
+            let (Some(k), Some((_, values))) = (k, tangent.as_mut()) else {
+                continue;
+            };
             for (sa, na) in c.nodes.into_iter().enumerate() {
                 for (sb, nb) in c.nodes.into_iter().enumerate() {
                     let sign = if sa == sb { 1.0 } else { -1.0 };
@@ -408,19 +466,21 @@ impl System {
             j.evaluate([&state.frames[a], &state.frames[b]], &mut rows);
             let first = self.joint_row[k] - self.n_free;
             // Tangent: s Σ μ ∂²g on the rotation blocks.
-            for sa in 0..2 {
-                for sb in 0..2 {
-                    let (na, nb) = (j.nodes[sa], j.nodes[sb]);
-                    for ca in (0..6).filter(|&c| self.dof[na][c] != FIXED) {
-                        for cb in (0..6).filter(|&c| self.dof[nb][c] != FIXED) {
-                            let mut v = 0.0;
-                            if ca >= 3 && cb >= 3 {
-                                for (r, row) in rows.iter().enumerate() {
-                                    v += state.multipliers[first + r]
-                                        * row.curvature[sa][sb][(ca - 3, cb - 3)];
+            if let Some((_, values)) = tangent.as_mut() {
+                for sa in 0..2 {
+                    for sb in 0..2 {
+                        let (na, nb) = (j.nodes[sa], j.nodes[sb]);
+                        for ca in (0..6).filter(|&c| self.dof[na][c] != FIXED) {
+                            for cb in (0..6).filter(|&c| self.dof[nb][c] != FIXED) {
+                                let mut v = 0.0;
+                                if ca >= 3 && cb >= 3 {
+                                    for (r, row) in rows.iter().enumerate() {
+                                        v += state.multipliers[first + r]
+                                            * row.curvature[sa][sb][(ca - 3, cb - 3)];
+                                    }
                                 }
+                                values.push(s * v);
                             }
-                            values.push(s * v);
                         }
                     }
                 }
@@ -435,6 +495,9 @@ impl System {
                     {
                         *f += s * mu * g;
                     }
+                    let Some((_, values)) = tangent.as_mut() else {
+                        continue;
+                    };
                     for c in (0..6).filter(|&c| self.dof[n][c] != FIXED) {
                         let g = s * row.gradient[6 * slot + c];
                         values.push(g);
@@ -443,7 +506,10 @@ impl System {
                 }
             }
         }
-        values.extend(std::iter::repeat_n(0.0, self.n_rows));
+        if let Some((_, values)) = tangent.as_mut() {
+            values.extend(std::iter::repeat_n(0.0, self.n_rows));
+            debug_assert_eq!(values.len(), self.pattern.len());
+        }
 
         for l in &model.loads {
             for c in 0..3 {
@@ -460,10 +526,8 @@ impl System {
                 }
             }
         }
-        debug_assert_eq!(values.len(), self.pattern.len());
-        Evaluation {
+        Forces {
             residual,
-            values,
             reactions,
             internal_scale,
             prestress_scale,
@@ -476,18 +540,22 @@ impl System {
     /// A singular tangent: for the dense factor, a pivot below `n ε ‖J‖max`,
     /// the roundoff of a zero pivot (a mechanism).
     pub fn factor(&self, values: &[f64]) -> Result<Factor, FactorError> {
-        self.factor_in(values, Precision::Double)
+        self.refactor(values, Precision::Double, None)
     }
 
     /// [`System::factor`] with the cable net's LDLᵀ in `precision` where
-    /// the tangent is condensed (the dense and sparse LU are double).
+    /// the tangent is condensed (the dense and sparse LU are double), in
+    /// `previous`'s storage where it has the same form (a refactorisation:
+    /// at 10⁵ nodes a fresh LDLᵀ's first touch of its pages cost as much as
+    /// a third of the factorisation).
     ///
     /// # Errors
     /// As [`System::factor`].
-    pub(crate) fn factor_in(
+    pub(crate) fn refactor(
         &self,
         values: &[f64],
         precision: Precision,
+        previous: Option<Factor>,
     ) -> Result<Factor, FactorError> {
         let count = values.iter().filter(|v| !v.is_finite()).count();
         if count > 0 {
@@ -514,7 +582,11 @@ impl System {
         }
         let lu = match &self.sparse {
             SparseFactorisation::Condensed(c) => {
-                return Ok(Factor::Condensed(c.factor(values, precision)?))
+                let previous = match previous {
+                    Some(Factor::Condensed(f)) => Some(f),
+                    _ => None,
+                };
+                return Ok(Factor::Condensed(c.factor(values, precision, previous)?));
             }
             SparseFactorisation::Lu(lu) => lu,
         };

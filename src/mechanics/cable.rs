@@ -77,6 +77,13 @@ impl Cable {
     }
 
     /// Internal force on the end node `b` (the force on `a` is its negative),
+    /// `T e` with `e = (b − a)/ℓ`: [`Cable::force_tangent`]'s force alone.
+    pub(crate) fn force(&self, a: &Vector3<f64>, b: &Vector3<f64>, lambda: f64) -> Vector3<f64> {
+        let s = self.state(a, b, lambda);
+        (b - a) / s.length_m * s.tension_n
+    }
+
+    /// Internal force on the end node `b` (the force on `a` is its negative),
     /// `T e` with `e = (b − a)/ℓ`, and its derivative with respect to `x_b`:
     /// `k = (EA/L₀) e eᵀ + (T/ℓ)(I − e eᵀ)` (the element tangent is
     /// `[k −k; −k k]`), where a slack cable's axial term is

@@ -316,7 +316,8 @@ impl Condensation {
         }))
     }
 
-    /// Factor the tangent with `values` (pattern order).
+    /// Factor the tangent with `values` (pattern order), in `previous`'s
+    /// storage where it has `precision`.
     ///
     /// # Errors
     /// A zero pivot of `M` (a point no taut cable holds) or a singular `S`.
@@ -324,7 +325,9 @@ impl Condensation {
         self: &Arc<Self>,
         values: &[f64],
         precision: Precision,
+        previous: Option<CondensedFactor>,
     ) -> Result<CondensedFactor, CondensedError> {
+        let storage = previous.map(|f| f.l);
         let m = self.coupled.len();
         let tau = self
             .diagonal
@@ -334,13 +337,21 @@ impl Condensation {
         let matrix = self.m.matrix(values, tau, &[])?;
         let (l, l22, lambda2) = match precision {
             Precision::Double => {
-                let (l, (l22, lambda2)) = self.numeric(matrix.as_ref())?;
+                let storage = match storage {
+                    Some(Values::Double(l)) => l,
+                    _ => Vec::new(),
+                };
+                let (l, (l22, lambda2)) = self.numeric(matrix.as_ref(), storage)?;
                 (Values::Double(l), l22, lambda2)
             }
             Precision::Single => {
                 let single: Vec<f32> = matrix.val().iter().map(|&v| f32::of(v)).collect();
                 let single = SparseColMatRef::new(matrix.symbolic(), &single);
-                let (l, (l22, lambda2)) = self.numeric(single)?;
+                let storage = match storage {
+                    Some(Values::Single(l)) => l,
+                    _ => Vec::new(),
+                };
+                let (l, (l22, lambda2)) = self.numeric(single, storage)?;
                 (Values::Single(l), l22, lambda2)
             }
         };
@@ -369,14 +380,17 @@ impl Condensation {
         })
     }
 
-    /// `matrix`'s (`M`'s) LDLᵀ values in its symbolic factorisation, and
-    /// the factors `L₂₂`, `Λ₂` of its trailing Schur complement.
+    /// `matrix`'s (`M`'s) LDLᵀ values in its symbolic factorisation (in
+    /// `l`'s allocation, when it has one), and the factors `L₂₂`, `Λ₂` of
+    /// its trailing Schur complement.
     fn numeric<T: Real>(
         &self,
         matrix: SparseColMatRef<'_, usize, T>,
+        mut l: Vec<T>,
     ) -> Result<(Vec<T>, Trailing), CondensedError> {
         let par = self.par;
-        let mut l = vec![T::zero(); self.ldlt.len_val()];
+        // faer zeroes the values itself.
+        l.resize(self.ldlt.len_val(), T::zero());
         let mut buffer = MemBuffer::try_new(
             self.ldlt
                 .factorize_numeric_ldlt_scratch::<T>(par, Default::default()),
@@ -737,7 +751,7 @@ mod tests {
             *mu = noise(13 * k);
         }
         let ev = system.evaluate(&model, &state, 0.7);
-        (system, ev.values, ev.residual)
+        (system, ev.values, ev.forces.residual)
     }
 
     /// The condensed solve agrees with a dense LU of the whole tangent, on
@@ -787,7 +801,7 @@ mod tests {
         use super::Precision;
         for flexible in [true, false] {
             let (system, values, residual) = tangent(flexible);
-            let single = system.factor_in(&values, Precision::Single).unwrap();
+            let single = system.refactor(&values, Precision::Single, None).unwrap();
             let dense = system.dense_tangent(&values);
             let n = system.n_rows;
             let rhs = faer::Mat::from_fn(n, 1, |i, _| residual[i]);

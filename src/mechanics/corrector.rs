@@ -135,7 +135,7 @@ impl<'a> Corrector<'a> {
         for it in 0..=self.settings.max_iterations {
             let lambda = lambda0 + dl;
             let ev = system.evaluate(self.solver.model(), &state, lambda);
-            let (force, converged) = self.solver.converged(&ev, lambda, self.settings);
+            let (force, converged) = self.solver.converged(&ev.forces, lambda, self.settings);
             residuals.push(force);
             if !force.is_finite() {
                 self.non_finite.set(true);
@@ -149,7 +149,7 @@ impl<'a> Corrector<'a> {
                     d_lambda: dl,
                     iterations: it,
                     residuals,
-                    reactions: ev.reactions,
+                    reactions: ev.forces.reactions,
                 });
             }
             if it == self.settings.max_iterations {
@@ -165,7 +165,7 @@ impl<'a> Corrector<'a> {
             };
             let mut rhs = Mat::from_fn(n, 2, |i, j| {
                 if j == 0 {
-                    -ev.residual[i]
+                    -ev.forces.residual[i]
                 } else {
                     self.f_hat[i]
                 }

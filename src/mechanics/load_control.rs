@@ -141,7 +141,7 @@ fn newton(
         let ev = damped
             .take()
             .unwrap_or_else(|| solver.system().evaluate(solver.model(), state, lambda));
-        let (force, converged) = solver.converged(&ev, lambda, settings);
+        let (force, converged) = solver.converged(&ev.forces, lambda, settings);
         run.residuals.push(force);
         run.iterations = it;
         if !force.is_finite() {
@@ -150,7 +150,7 @@ fn newton(
         }
         if converged || increment_small {
             run.end = NewtonEnd::Converged;
-            run.reactions = ev.reactions;
+            run.reactions = ev.forces.reactions;
             break;
         }
         if it == 0 {
@@ -168,7 +168,7 @@ fn newton(
                 break;
             }
         };
-        let mut rhs = solver.system().column(&ev.residual);
+        let mut rhs = solver.system().column(&ev.forces.residual);
         System::solve_in_place(&lu, rhs.as_mut());
         let delta: Vec<f64> = (0..solver.system().n_rows).map(|i| -rhs[(i, 0)]).collect();
         if !delta.iter().all(|d| d.is_finite()) {
@@ -177,11 +177,11 @@ fn newton(
         }
         let curvature: f64 = delta
             .iter()
-            .zip(&ev.residual)
+            .zip(&ev.forces.residual)
             .enumerate()
             .map(|(i, (d, r))| if i < n_free { -d * r } else { d * r })
             .sum();
-        if curvature < -CURVATURE_NOISE * norm2(&delta) * norm2(&ev.residual) {
+        if curvature < -CURVATURE_NOISE * norm2(&delta) * norm2(&ev.forces.residual) {
             run.negative_curvature = true;
         }
         let size = wdot(w, &delta, &delta).sqrt();
@@ -204,7 +204,7 @@ fn newton(
             while step >= MIN_DAMPING {
                 solver.system().apply(state, &delta, step);
                 let trial = solver.system().evaluate(solver.model(), state, lambda);
-                let (after, _) = solver.converged(&trial, lambda, settings);
+                let (after, _) = solver.converged(&trial.forces, lambda, settings);
                 if after < force {
                     damped = Some(trial);
                     increment_small = small && step == 1.0;
@@ -215,11 +215,11 @@ fn newton(
             }
             if damped.is_none() {
                 if solver
-                    .converged_within(&ev, lambda, settings, FLOOR_FACTOR)
+                    .converged_within(&ev.forces, lambda, settings, FLOOR_FACTOR)
                     .1
                 {
                     run.end = NewtonEnd::Converged;
-                    run.reactions = ev.reactions;
+                    run.reactions = ev.forces.reactions;
                 }
                 break;
             }

@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use super::assembly::{Evaluation, State, System};
+use super::assembly::{Forces, State, System};
 use super::model::{MechanicsError, Model};
 use super::settings::StaticSettings;
 use crate::algebra::norm_inf;
@@ -176,7 +176,7 @@ impl StaticSolver {
     /// metres and stiff tubes put it near 1e-7 N).
     pub(super) fn converged(
         &self,
-        ev: &Evaluation,
+        ev: &Forces,
         lambda: f64,
         settings: &StaticSettings,
     ) -> (f64, bool) {
@@ -186,7 +186,7 @@ impl StaticSolver {
     /// [`StaticSolver::converged`] with the tolerances × `factor`.
     pub(super) fn converged_within(
         &self,
-        ev: &Evaluation,
+        ev: &Forces,
         lambda: f64,
         settings: &StaticSettings,
         factor: f64,

@@ -8,7 +8,8 @@
 //! silently wrong state.
 
 use super::arc_length;
-use super::assembly::{Evaluation, Factor, Precision, State, System};
+use super::assembly::{Factor, Forces, Precision, State, System};
+use super::cable::SLACK_STIFFNESS_RATIO;
 use super::load_control;
 use super::model::MechanicsError;
 use super::model::Model;
@@ -67,12 +68,12 @@ impl StaticSolver {
         let mut state = self.reference_state();
         let ev = self.system().evaluate(self.model(), &state, 1.0);
         let lu = self.system().factor(&ev.values)?;
-        if let Some(i) = ev.residual.iter().position(|r| !r.is_finite()) {
+        if let Some(i) = ev.forces.residual.iter().position(|r| !r.is_finite()) {
             return Err(MechanicsError::NotFinite {
                 detail: format!("the load or residual of unknown {i} is not finite"),
             });
         }
-        let mut rhs = self.system().column(&ev.residual);
+        let mut rhs = self.system().column(&ev.forces.residual);
         System::solve_in_place(&lu, rhs.as_mut());
         let delta: Vec<f64> = (0..self.system().n_rows).map(|i| -rhs[(i, 0)]).collect();
         if !delta.iter().all(|d| d.is_finite()) {
@@ -101,7 +102,7 @@ impl StaticSolver {
             solver: self,
             state: state.clone(),
             lambda,
-            residual: ev.residual,
+            residual: ev.forces.residual,
             factor,
         })
     }
@@ -141,8 +142,8 @@ impl Linearisation<'_> {
     pub fn respond(&self, changed: &Model) -> Result<State, MechanicsError> {
         self.solver.check_structure(changed)?;
         let system = self.solver.system();
-        let ev = system.evaluate(changed, &self.state, self.lambda);
-        let change: Vec<f64> = ev
+        let forces = system.forces(changed, &self.state, self.lambda);
+        let change: Vec<f64> = forces
             .residual
             .iter()
             .zip(&self.residual)
@@ -226,7 +227,11 @@ impl Linearisation<'_> {
         let mut refreshed: Option<Factor> = None;
         let mut refactorisations = 0;
         let mut previous = f64::INFINITY;
-        let mut ev = system.evaluate_with(changed, &state, self.lambda, SLACK_ITERATION_RATIO);
+        let mut forces = system.forces(changed, &state, self.lambda);
+        // The tangent values of the last refactorisation: its buffer is
+        // reused, as the factor's storage is (at 10⁵ nodes a fresh one's
+        // first touch of each page cost as much as the numbers in it).
+        let mut values = Vec::new();
         // The current iterate's slack cables, and how many the last step
         // changed. (Counting only full steps, a shortened one leaving the
         // slack cables unsettled, slowed super-100m's four samples 31.2 →
@@ -247,7 +252,7 @@ impl Linearisation<'_> {
         // Whether the last step was taken with a factor refactored for it.
         let mut refactored = false;
         for iteration in 0..=settings.max_iterations {
-            let converged = self.solver.converged(&ev, self.lambda, settings).1;
+            let converged = self.solver.converged(&forces, self.lambda, settings).1;
             if converged && (newton || polished == POLISHING_STEPS) {
                 return Ok(Some((state, iteration)));
             }
@@ -262,8 +267,8 @@ impl Linearisation<'_> {
             // (each super-100m sample tried four such steps, every one
             // refused, 0.07 s a solve).
             let stale = refactored && !settled && !converged;
-            let chord =
-                (!stale).then(|| step(refreshed.as_ref().unwrap_or(&self.factor), &ev.residual));
+            let chord = (!stale)
+                .then(|| step(refreshed.as_ref().unwrap_or(&self.factor), &forces.residual));
             newton = false;
             refactored = false;
             polished += usize::from(converged);
@@ -276,29 +281,35 @@ impl Linearisation<'_> {
                     if refactorisations == CHORD_REFACTORISATIONS {
                         return Ok(None);
                     }
-                    let exact;
-                    let values = if settled {
-                        exact = system.evaluate(changed, &state, self.lambda);
-                        &exact.values
-                    } else {
-                        &ev.values
+                    let tangent = |ratio, values: &mut Vec<f64>| {
+                        system.tangent_into(changed, &state, self.lambda, ratio, values);
                     };
+                    let ratio = if settled {
+                        SLACK_STIFFNESS_RATIO
+                    } else {
+                        SLACK_ITERATION_RATIO
+                    };
+                    tangent(ratio, &mut values);
                     // The exact tangent keeps 1e-9 EA on slack cables: should it
                     // not factor, the iteration matrix does; should that not
                     // factor in single precision, in double (its pivots below
                     // f32's roundoff, or beyond its range).
-                    let factored = system.factor_in(values, Precision::Single);
+                    let factored = system.refactor(&values, Precision::Single, refreshed.take());
                     let factored = if settled {
-                        factored.or_else(|_| system.factor_in(&ev.values, Precision::Single))
+                        factored.or_else(|_| {
+                            tangent(SLACK_ITERATION_RATIO, &mut values);
+                            system.refactor(&values, Precision::Single, None)
+                        })
                     } else {
                         factored
                     };
-                    let factored = factored.or_else(|_| system.factor(&ev.values));
+                    let factored =
+                        factored.or_else(|_| system.refactor(&values, Precision::Double, None));
                     let Ok(factor) = factored else {
                         return Ok(None);
                     };
                     refactorisations += 1;
-                    let newton_step = step(&factor, &ev.residual);
+                    let newton_step = step(&factor, &forces.residual);
                     refreshed = Some(factor);
                     newton = true;
                     refactored = true;
@@ -312,29 +323,28 @@ impl Linearisation<'_> {
             // step past cables going slack (or taut again) can overshoot by
             // far; one that brings the slack cables nearer their set raises
             // the residual a little for an iteration.
-            let norm = norm2(&ev.residual);
-            let mut best: Option<(f64, f64, State, Evaluation)> = None;
+            let norm = norm2(&forces.residual);
+            let mut best: Option<(f64, f64, State, Forces)> = None;
             let mut fraction = 1.0;
             for _ in 0..=LINE_SEARCH_HALVINGS {
                 let mut trial = state.clone();
                 system.apply(&mut trial, &delta, fraction);
-                let trial_ev =
-                    system.evaluate_with(changed, &trial, self.lambda, SLACK_ITERATION_RATIO);
-                let trial_norm = norm2(&trial_ev.residual);
+                let trial_forces = system.forces(changed, &trial, self.lambda);
+                let trial_norm = norm2(&trial_forces.residual);
                 let decreases = trial_norm < ACCEPTED_RESIDUAL_GROWTH * norm;
                 if trial_norm.is_finite() && best.as_ref().is_none_or(|b| trial_norm < b.1) {
-                    best = Some((fraction, trial_norm, trial, trial_ev));
+                    best = Some((fraction, trial_norm, trial, trial_forces));
                 }
                 if decreases {
                     break;
                 }
                 fraction *= 0.5;
             }
-            let Some((fraction, trial_norm, trial, trial_ev)) = best else {
+            let Some((fraction, trial_norm, trial, trial_forces)) = best else {
                 return Ok(None);
             };
             state = trial;
-            ev = trial_ev;
+            forces = trial_forces;
             let now = slack_cables(changed, &state, self.lambda);
             slack_changed = now.iter().zip(&slack).filter(|(a, b)| a != b).count();
             slack = now;
