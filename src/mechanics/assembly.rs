@@ -580,21 +580,27 @@ impl System {
             }
             return Ok(Factor::Dense(lu));
         }
-        let lu = match &self.sparse {
-            SparseFactorisation::Condensed(c) => {
+        match (&self.sparse, previous) {
+            (SparseFactorisation::Condensed(c), previous) => {
                 let previous = match previous {
                     Some(Factor::Condensed(f)) => Some(f),
                     _ => None,
                 };
-                return Ok(Factor::Condensed(c.factor(values, precision, previous)?));
+                Ok(Factor::Condensed(c.factor(values, precision, previous)?))
             }
-            SparseFactorisation::Lu(lu) => lu,
-        };
-        let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
-            .map_err(FactorError::SparseMatrix)?;
-        Lu::try_new_with_symbolic(lu.clone(), matrix.as_ref())
-            .map(Factor::Sparse)
-            .map_err(FactorError::SparseLu)
+            (SparseFactorisation::Lu(lu), previous) => {
+                let previous = match previous {
+                    Some(Factor::Sparse(f)) => Some(f),
+                    _ => None,
+                };
+                let matrix = self
+                    .sparse_tangent(values)
+                    .map_err(FactorError::SparseMatrix)?;
+                Lu::refactor(lu.clone(), matrix.as_ref(), previous)
+                    .map(Factor::Sparse)
+                    .map_err(FactorError::SparseLu)
+            }
+        }
     }
 
     /// The tangent with `values` (pattern order) as a dense matrix.

@@ -55,7 +55,7 @@ use faer::sparse::linalg::cholesky::{
     SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Accum, Mat, MatMut, Par, Side};
 
 /// The parallelism of the net's LDLᵀ and its solves: one thread, as the
@@ -73,9 +73,6 @@ pub(crate) enum CondensedError {
     /// A zero pivot of `M`'s LDLᵀ.
     #[error("LDLᵀ of the net: {0:?}")]
     Ldlt(LdltError),
-    /// faer could not build a block from the tangent's values.
-    #[error("{0:?}")]
-    SparseMatrix(faer::sparse::FaerError),
     /// faer's sparse LU of `S` failed (the frame is a mechanism, or memory).
     #[error("LU of the frame: {0:?}")]
     SparseLu(faer::sparse::linalg::LuError),
@@ -98,41 +95,50 @@ enum Source {
 /// A matrix whose entries are gathered from the tangent's values.
 struct Block {
     symbolic: SymbolicSparseColMat<usize>,
-    argsort: Argsort<usize>,
+    /// The sources of the entries, in the pattern's (compressed column)
+    /// order: entry `k` sums `source[group[k]..group[k + 1]]`.
     source: Vec<Source>,
+    group: Vec<usize>,
 }
 
 impl Block {
-    fn new(n: usize, entries: Vec<(Pair<usize, usize>, Source)>) -> Result<Self, String> {
-        let (pairs, source): (Vec<_>, Vec<_>) = entries.into_iter().unzip();
-        let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &pairs)
-            .map_err(|e| format!("sparsity pattern: {}", e.plain()))?;
-        Ok(Block {
-            symbolic,
-            argsort,
-            source,
-        })
+    fn new(n: usize, mut entries: Vec<(Pair<usize, usize>, Source)>) -> Self {
+        // Stable: duplicates sum in the tangent's order.
+        entries.sort_by_key(|(at, _)| (at.col, at.row));
+        let mut col_ptr = vec![0usize; n + 1];
+        let (mut row_idx, mut group) = (Vec::new(), Vec::new());
+        for (k, (at, _)) in entries.iter().enumerate() {
+            if k == 0 || entries[k - 1].0 != *at {
+                group.push(k);
+                row_idx.push(at.row);
+                col_ptr[at.col + 1] += 1;
+            }
+        }
+        group.push(entries.len());
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        Block {
+            symbolic: SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
+            source: entries.into_iter().map(|(_, source)| source).collect(),
+            group,
+        }
     }
 
-    /// The matrix at the tangent's `values`, the shift `τ` and the coupling
-    /// block `−G` (column-major).
-    fn matrix(
-        &self,
-        values: &[f64],
-        tau: f64,
-        minus_g: &[f64],
-    ) -> Result<SparseColMat<usize, f64>, CondensedError> {
-        let gathered: Vec<f64> = self
-            .source
-            .iter()
-            .map(|s| match *s {
-                Source::Tangent(p) => values[p],
-                Source::Shift => -tau,
-                Source::Coupling(k) => minus_g[k],
-            })
-            .collect();
-        SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, &gathered)
-            .map_err(CondensedError::SparseMatrix)
+    /// The matrix's values (its pattern's order) at the tangent's `values`,
+    /// the shift `τ` and the coupling block `−G` (column-major), into `out`.
+    fn values_into<T: Real>(&self, values: &[f64], tau: f64, minus_g: &[f64], out: &mut Vec<T>) {
+        let value = |s: &Source| match *s {
+            Source::Tangent(p) => values[p],
+            Source::Shift => -tau,
+            Source::Coupling(k) => minus_g[k],
+        };
+        out.clear();
+        out.extend(
+            self.group
+                .windows(2)
+                .map(|g| T::of(self.source[g[0]..g[1]].iter().map(value).sum())),
+        );
     }
 }
 
@@ -167,10 +173,22 @@ pub(crate) enum Precision {
     Single,
 }
 
-/// `M`'s LDLᵀ values, in the precision they were computed in.
+/// A factor's numeric storage in one precision, which a refactorisation
+/// in it reuses: at 10⁵ nodes the first touch of a fresh buffer's pages
+/// cost a third of the LDLᵀ.
+struct Storage<T> {
+    /// `M`'s values (its pattern's order).
+    matrix: Vec<T>,
+    /// `M`'s LDLᵀ values.
+    l: Vec<T>,
+    /// The LDLᵀ's workspace.
+    scratch: MemBuffer,
+}
+
+/// `M`'s LDLᵀ, in the precision it was computed in.
 enum Values {
-    Double(Vec<f64>),
-    Single(Vec<f32>),
+    Double(Storage<f64>),
+    Single(Storage<f32>),
 }
 
 /// A real type the net's LDLᵀ can be computed in.
@@ -283,7 +301,7 @@ impl Condensation {
                 s_entries.push((at, Source::Coupling(k * m + i)));
             }
         }
-        let m_block = Block::new(n_p + m, m_entries)?;
+        let m_block = Block::new(n_p + m, m_entries);
         let ldlt = factorize_symbolic_cholesky(
             m_block.symbolic.as_ref(),
             Side::Lower,
@@ -294,7 +312,7 @@ impl Condensation {
             },
         )
         .map_err(|e| format!("symbolic LDLᵀ of the net: {}", e.plain()))?;
-        let s = Block::new(rest.len(), s_entries)?;
+        let s = Block::new(rest.len(), s_entries);
         let lu = if rest.is_empty() {
             None
         } else {
@@ -327,32 +345,32 @@ impl Condensation {
         precision: Precision,
         previous: Option<CondensedFactor>,
     ) -> Result<CondensedFactor, CondensedError> {
-        let storage = previous.map(|f| f.l);
+        let (storage, previous_s) = match previous {
+            Some(f) => (Some(f.l), f.s),
+            None => (None, None),
+        };
         let m = self.coupled.len();
         let tau = self
             .diagonal
             .iter()
             .map(|&p| values[p].abs())
             .fold(f64::MIN_POSITIVE, f64::max);
-        let matrix = self.m.matrix(values, tau, &[])?;
-        let (l, l22, lambda2) = match precision {
+        let (l, (l22, lambda2)) = match precision {
             Precision::Double => {
                 let storage = match storage {
-                    Some(Values::Double(l)) => l,
-                    _ => Vec::new(),
+                    Some(Values::Double(s)) => Some(s),
+                    _ => None,
                 };
-                let (l, (l22, lambda2)) = self.numeric(matrix.as_ref(), storage)?;
-                (Values::Double(l), l22, lambda2)
+                let (l, trailing) = self.numeric(values, tau, storage)?;
+                (Values::Double(l), trailing)
             }
             Precision::Single => {
-                let single: Vec<f32> = matrix.val().iter().map(|&v| f32::of(v)).collect();
-                let single = SparseColMatRef::new(matrix.symbolic(), &single);
                 let storage = match storage {
-                    Some(Values::Single(l)) => l,
-                    _ => Vec::new(),
+                    Some(Values::Single(s)) => Some(s),
+                    _ => None,
                 };
-                let (l, (l22, lambda2)) = self.numeric(single, storage)?;
-                (Values::Single(l), l22, lambda2)
+                let (l, trailing) = self.numeric(values, tau, storage)?;
+                (Values::Single(l), trailing)
             }
         };
         let s = match &self.lu {
@@ -364,11 +382,10 @@ impl Condensation {
                 for k in 0..m {
                     minus_g[k * m + k] += tau;
                 }
-                let s = self.s.matrix(values, tau, &minus_g)?;
-                Some(
-                    Lu::try_new_with_symbolic(lu.clone(), s.as_ref())
-                        .map_err(CondensedError::SparseLu)?,
-                )
+                let mut s_values = Vec::new();
+                self.s.values_into(values, tau, &minus_g, &mut s_values);
+                let s = SparseColMatRef::new(self.s.symbolic.as_ref(), &s_values);
+                Some(Lu::refactor(lu.clone(), s, previous_s).map_err(CondensedError::SparseLu)?)
             }
         };
         Ok(CondensedFactor {
@@ -380,35 +397,49 @@ impl Condensation {
         })
     }
 
-    /// `matrix`'s (`M`'s) LDLᵀ values in its symbolic factorisation (in
-    /// `l`'s allocation, when it has one), and the factors `L₂₂`, `Λ₂` of
-    /// its trailing Schur complement.
+    /// `M`'s LDLᵀ at the tangent's `values` and the shift `tau` (in
+    /// `storage`, when there is one), and the factors `L₂₂`, `Λ₂` of its
+    /// trailing Schur complement.
     fn numeric<T: Real>(
         &self,
-        matrix: SparseColMatRef<'_, usize, T>,
-        mut l: Vec<T>,
-    ) -> Result<(Vec<T>, Trailing), CondensedError> {
+        values: &[f64],
+        tau: f64,
+        storage: Option<Storage<T>>,
+    ) -> Result<(Storage<T>, Trailing), CondensedError> {
         let par = self.par;
+        let mut storage = match storage {
+            Some(storage) => storage,
+            None => Storage {
+                matrix: Vec::new(),
+                l: Vec::new(),
+                scratch: MemBuffer::try_new(
+                    self.ldlt
+                        .factorize_numeric_ldlt_scratch::<T>(par, Default::default()),
+                )
+                .map_err(|_| CondensedError::OutOfMemory)?,
+            },
+        };
+        self.m.values_into(values, tau, &[], &mut storage.matrix);
         // faer zeroes the values itself.
-        l.resize(self.ldlt.len_val(), T::zero());
-        let mut buffer = MemBuffer::try_new(
-            self.ldlt
-                .factorize_numeric_ldlt_scratch::<T>(par, Default::default()),
-        )
-        .map_err(|_| CondensedError::OutOfMemory)?;
+        storage.l.resize(self.ldlt.len_val(), T::zero());
         self.ldlt
             .factorize_numeric_ldlt(
-                &mut l,
-                matrix,
+                &mut storage.l,
+                SparseColMatRef::new(self.m.symbolic.as_ref(), &storage.matrix),
                 Side::Lower,
                 LdltRegularization::default(),
                 par,
-                MemStack::new(&mut buffer),
+                MemStack::new(&mut storage.scratch),
                 Default::default(),
             )
             .map_err(CondensedError::Ldlt)?;
-        let trailing = trailing_factor(&self.ldlt, &l, self.points.len(), self.coupled.len());
-        Ok((l, trailing))
+        let trailing = trailing_factor(
+            &self.ldlt,
+            &storage.l,
+            self.points.len(),
+            self.coupled.len(),
+        );
+        Ok((storage, trailing))
     }
 }
 
@@ -583,8 +614,8 @@ impl CondensedFactor {
     /// sweep).
     pub(crate) fn solve_in_place(&self, rhs: MatMut<'_, f64>) {
         match &self.l {
-            Values::Double(l) => self.solve_with(l, rhs),
-            Values::Single(l) => self.solve_with(l, rhs),
+            Values::Double(storage) => self.solve_with(&storage.l, rhs),
+            Values::Single(storage) => self.solve_with(&storage.l, rhs),
         }
     }
 

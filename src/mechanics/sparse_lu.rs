@@ -40,10 +40,11 @@ const PARALLELISM: Par = Par::Seq;
 pub(crate) struct SymbolicLu(Arc<Symbolic<usize>>);
 
 /// A numeric sparse LU of one matrix of a [`SymbolicLu`]'s pattern.
-#[derive(Debug)]
 pub(crate) struct Lu {
     symbolic: SymbolicLu,
     numeric: NumericLu<usize, f64>,
+    /// The factorisation's workspace, kept for [`Lu::refactor`].
+    scratch: MemBuffer,
     par: Par,
 }
 
@@ -64,31 +65,40 @@ impl SymbolicLu {
 }
 
 impl Lu {
-    /// Factor `matrix`, of `symbolic`'s pattern, with partial pivoting.
+    /// Factor `matrix`, of `symbolic`'s pattern, with partial pivoting, in
+    /// `previous`'s storage where it is a factor of the same pattern (a
+    /// Newton iteration's refactorisation).
     ///
     /// # Errors
     /// A structurally or numerically singular matrix, or out of memory.
-    pub(crate) fn try_new_with_symbolic(
+    pub(crate) fn refactor(
         symbolic: SymbolicLu,
         matrix: SparseColMatRef<'_, usize, f64>,
+        previous: Option<Lu>,
     ) -> Result<Self, LuError> {
         let par = PARALLELISM;
-        let mut numeric = NumericLu::new();
-        let scratch = symbolic
-            .0
-            .factorize_numeric_lu_scratch::<f64>(par, Default::default());
-        let mut buffer =
-            MemBuffer::try_new(scratch).map_err(|_| LuError::Generic(FaerError::OutOfMemory))?;
+        let (mut numeric, mut scratch) = match previous {
+            Some(lu) if Arc::ptr_eq(&lu.symbolic.0, &symbolic.0) => (lu.numeric, lu.scratch),
+            _ => {
+                let req = symbolic
+                    .0
+                    .factorize_numeric_lu_scratch::<f64>(par, Default::default());
+                let scratch = MemBuffer::try_new(req)
+                    .map_err(|_| LuError::Generic(FaerError::OutOfMemory))?;
+                (NumericLu::new(), scratch)
+            }
+        };
         symbolic.0.factorize_numeric_lu(
             &mut numeric,
             matrix,
             par,
-            MemStack::new(&mut buffer),
+            MemStack::new(&mut scratch),
             Default::default(),
         )?;
         Ok(Lu {
             symbolic,
             numeric,
+            scratch,
             par,
         })
     }
