@@ -33,6 +33,12 @@
 //! * `RINGMESH_SIDE_GRADIENT` — `1` runs `gradient` at every size, `0` at
 //!   none (default: up to ~10³ free nodes; on the jittered net at 10⁴ it
 //!   took 871 s, at 10⁵ over half an hour a net);
+//! * `RINGMESH_SIDE_NETS` — comma-separated network files (interchange
+//!   JSON, e.g. `ringmesh mesh`'s `network.json` of a shipped scene), each
+//!   solved as `ringmesh uniformity` poses it (its `front` group the set;
+//!   `gradient` only with `RINGMESH_SIDE_GRADIENT=1`), after the families
+//!   named in `RINGMESH_SIDE_FAMILIES` (none by default when files are
+//!   given); the family column is the file's path without `.json`;
 //! * `RINGMESH_SIDE_CSV` — the CSV's path (default
 //!   `target/side-by-side.csv`; a first argument not starting with `-`
 //!   overrides both).
@@ -40,6 +46,8 @@
 //! ```text
 //! cargo bench --bench side_by_side
 //! RINGMESH_SIDE_FREE=100000 cargo bench --bench side_by_side
+//! ringmesh mesh problems/super-100m.toml -o target/super-100m-mesh
+//! RINGMESH_SIDE_NETS=target/super-100m-mesh/network.json cargo bench --bench side_by_side
 //! ```
 //!
 //! `scripts/bench/side-by-side.sh` runs it into `results/bench/side-by-side.csv`.
@@ -55,7 +63,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use ringmesh::network::Network;
 use ringmesh::report::json_name;
+use ringmesh::run::uniformity_problem;
 use ringmesh::uniformity::{Gradient, Lp, UniformityProblem, UniformitySolver};
 
 /// Relative ratio difference to `lp`'s beyond which a row is marked `NO`.
@@ -101,10 +111,10 @@ impl Row {
     }
 }
 
-/// One net: its family, size and the rows of its solvers.
+/// One net: its family (or file), size and the rows of its solvers.
 #[derive(Debug)]
 struct NetRows {
-    family: &'static str,
+    family: String,
     free: usize,
     cables: usize,
     load: f64,
@@ -116,6 +126,9 @@ struct NetRows {
 struct Settings {
     free: Vec<usize>,
     families: Vec<nets::Family>,
+    /// Network files (interchange JSON) solved after the families, their
+    /// `front` group the set.
+    files: Vec<PathBuf>,
     repeats: usize,
     gradient: Option<bool>,
     csv: PathBuf,
@@ -133,7 +146,16 @@ impl Settings {
                 })
                 .collect()
         });
-        let families = var("RINGMESH_SIDE_FAMILIES").map_or(nets::Family::ALL.to_vec(), |v| {
+        let files = var("RINGMESH_SIDE_NETS").map_or_else(Vec::new, |v| {
+            v.split(',').map(|s| PathBuf::from(s.trim())).collect()
+        });
+        // Network files alone unless families are named too.
+        let all = if files.is_empty() {
+            nets::Family::ALL.to_vec()
+        } else {
+            Vec::new()
+        };
+        let families = var("RINGMESH_SIDE_FAMILIES").map_or(all, |v| {
             v.split(',')
                 .map(|s| {
                     *nets::Family::ALL
@@ -165,6 +187,7 @@ impl Settings {
         Settings {
             free,
             families,
+            files,
             repeats,
             gradient,
             csv,
@@ -258,9 +281,28 @@ fn gradient_row(repeats: usize, p: &UniformityProblem) -> Row {
     }
 }
 
-/// Every solver on one net.
-fn measure(family: nets::Family, free_target: usize, settings: &Settings) -> NetRows {
+/// Every solver on the net of `family` with about `free_target` free nodes.
+fn measure_family(family: nets::Family, free_target: usize, settings: &Settings) -> NetRows {
     let p = family.problem(nets::rings_for(free_target));
+    let gradient = settings
+        .gradient
+        .unwrap_or(free_target <= GRADIENT_DEFAULT_MAX_FREE);
+    measure(family.name().to_string(), &p, gradient, settings)
+}
+
+/// Every solver on the network of `path` (`ringmesh uniformity`'s problem
+/// of it: its `front` group the set), `gradient` where asked for.
+fn measure_file(path: &Path, settings: &Settings) -> NetRows {
+    let network = Network::read_json(path)
+        .unwrap_or_else(|e| panic!("RINGMESH_SIDE_NETS: {}: {e}", path.display()));
+    let p = uniformity_problem(network, None, None, f64::INFINITY)
+        .unwrap_or_else(|e| panic!("RINGMESH_SIDE_NETS: {}: {e}", path.display()));
+    let name = path.with_extension("").display().to_string();
+    measure(name, &p, settings.gradient.unwrap_or(false), settings)
+}
+
+/// Every solver on the problem `p` of the net named `family`.
+fn measure(family: String, p: &UniformityProblem, gradient: bool, settings: &Settings) -> NetRows {
     let free = p.structure().free_nodes().len();
     let cables = p.sets()[0].edges.len();
     let repeats = if p.network().n_nodes() > REPEATED_MAX_NODES {
@@ -270,16 +312,15 @@ fn measure(family: nets::Family, free_target: usize, settings: &Settings) -> Net
     };
     let load = load_1min();
     eprintln!(
-        "{} / {free} free nodes ({} nodes, load {load:.2}):",
-        family.name(),
+        "{family} / {free} free nodes ({} nodes, load {load:.2}):",
         p.network().n_nodes()
     );
     let mut rows = Vec::new();
-    let lp = ringmesh_row("lp", repeats, &Lp, &p);
+    let lp = ringmesh_row("lp", repeats, &Lp, p);
     eprintln!("  lp {:.3} s", lp.time_s);
     rows.push(lp);
     for backend in ["qdldl", "faer"] {
-        let (o, time_s, solves) = best_of(repeats, || plan_lp::solve_plan(&p, backend));
+        let (o, time_s, solves) = best_of(repeats, || plan_lp::solve_plan(p, backend));
         eprintln!("  clarabel {backend} {time_s:.3} s");
         rows.push(Row {
             solver: "clarabel",
@@ -292,16 +333,13 @@ fn measure(family: nets::Family, free_target: usize, settings: &Settings) -> Net
             solves,
         });
     }
-    if settings
-        .gradient
-        .unwrap_or(free_target <= GRADIENT_DEFAULT_MAX_FREE)
-    {
-        let row = gradient_row(repeats, &p);
+    if gradient {
+        let row = gradient_row(repeats, p);
         eprintln!("  gradient {:.3} s ({})", row.time_s, row.route);
         rows.push(row);
     }
     NetRows {
-        family: family.name(),
+        family,
         free,
         cables,
         load,
@@ -423,10 +461,14 @@ fn main() {
     let mut nets_rows = Vec::new();
     for &free in &settings.free {
         for &family in &settings.families {
-            nets_rows.push(measure(family, free, &settings));
+            nets_rows.push(measure_family(family, free, &settings));
             // After every net, so that a run stopped early keeps its rows.
             write_csv(&settings.csv, &tables(&nets_rows).0);
         }
+    }
+    for path in &settings.files {
+        nets_rows.push(measure_file(path, &settings));
+        write_csv(&settings.csv, &tables(&nets_rows).0);
     }
     let (csv, table, disagreements) = tables(&nets_rows);
     println!("{table}");

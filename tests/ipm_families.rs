@@ -271,3 +271,34 @@ fn finish_table() {
         }
     }
 }
+
+/// A shipped scene's own net, whose sagged boundary cables lie outside the
+/// uniformity set (`plan.rs` keeps them in the net, bounded below by the
+/// tension floor): the plan interior point reaches clarabel's optimum of the
+/// same plan LP, posed independently (`tests/common/plan_lp.rs`), to 1e-6.
+#[test]
+fn a_shipped_scenes_net_with_its_boundary_outside_the_set_matches_clarabel() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/realistic-26m.toml");
+    let scene = ringmesh::scene::Scene::read(&path).unwrap();
+    let (_, problem) = ringmesh::design::scene_problem(&scene).unwrap();
+    let set = &problem.sets()[0].edges;
+    let network = problem.network();
+    let mut on_set = vec![false; network.n_nodes()];
+    for &k in set {
+        network.edges[k].iter().for_each(|&i| on_set[i] = true);
+    }
+    let outside = (0..network.n_edges())
+        .filter(|k| !set.contains(k) && network.edges[*k].iter().all(|&i| on_set[i]))
+        .count();
+    assert!(outside > 0, "the net has no cable outside its set");
+    let design = Lp.solve(&problem).expect("lp");
+    assert_eq!(design.route, Some(Route::PlanInteriorPoint));
+    let reference = plan_lp::solve_plan(&problem, "qdldl");
+    assert_eq!(reference.status, "Solved");
+    assert!(
+        (design.ratio / reference.ratio - 1.0).abs() <= 1e-6,
+        "{} vs clarabel's {}",
+        design.ratio,
+        reference.ratio
+    );
+}

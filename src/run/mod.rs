@@ -48,7 +48,9 @@ pub use optimize::{optimize, OptimizeOutcome};
 pub use size::{section_line, size, SizeOutcome};
 pub use study::{study, study_rows, StudyOptions, StudyOutcome, STRATEGIES_STEM, STUDY_STEM};
 pub use truss::{truss, TrussOutcome};
-pub use uniformity::{uniformity, uniformity_of, UniformityOutcome, UniformityOutput};
+pub use uniformity::{
+    uniformity, uniformity_of, uniformity_problem, UniformityOutcome, UniformityOutput,
+};
 
 use crate::report::{readable, OutputSet};
 use crate::scene::Scene;

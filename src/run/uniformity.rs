@@ -132,6 +132,43 @@ pub fn uniformity_of(
     mean_tension_n: Option<f64>,
     max_force_density_n_per_m: f64,
 ) -> Result<UniformityOutput, Error> {
+    let problem = uniformity_problem(network, groups, mean_tension_n, max_force_density_n_per_m)?;
+    let solver = solver.unwrap_or_else(|| SolverKind::default_for(1, problem.has_loads()));
+    let design = solver.configure(settings)?.solve(&problem)?.feasible()?;
+    let output = UniformityOutput {
+        ratio: design.ratio,
+        max_residual: design.max_residual_n,
+        tensions: problem
+            .lengths_m()
+            .iter()
+            .zip(&design.q)
+            .map(|(l, q)| l * q)
+            .collect(),
+        q: design.q,
+        solver: design.solver,
+        termination: design.termination,
+        iterations: design.iterations,
+        time_s: design.time_s,
+        route: design.route,
+        warnings: design.warnings,
+    };
+    Ok(output)
+}
+
+/// The uniformity problem of [`uniformity_of`]: `network` (validated here)
+/// at its own geometry, the set the union of `groups` (default `front`
+/// when the network has groups, else every cable), its mean tension
+/// `mean_tension_n` (default: the network's own), every free node a
+/// prescribed surface node.
+///
+/// # Errors
+/// An invalid network or group.
+pub fn uniformity_problem(
+    network: Network,
+    groups: Option<&[String]>,
+    mean_tension_n: Option<f64>,
+    max_force_density_n_per_m: f64,
+) -> Result<UniformityProblem, Error> {
     network.validate()?;
     let default_groups = vec!["front".to_string()];
     let groups: Vec<String> = match (groups, &network.groups) {
@@ -182,24 +219,5 @@ pub fn uniformity_of(
         SurfaceTarget::Prescribed,
         max_force_density_n_per_m,
     )?;
-    let solver = solver.unwrap_or_else(|| SolverKind::default_for(1, problem.has_loads()));
-    let design = solver.configure(settings)?.solve(&problem)?.feasible()?;
-    let output = UniformityOutput {
-        ratio: design.ratio,
-        max_residual: design.max_residual_n,
-        tensions: problem
-            .lengths_m()
-            .iter()
-            .zip(&design.q)
-            .map(|(l, q)| l * q)
-            .collect(),
-        q: design.q,
-        solver: design.solver,
-        termination: design.termination,
-        iterations: design.iterations,
-        time_s: design.time_s,
-        route: design.route,
-        warnings: design.warnings,
-    };
-    Ok(output)
+    Ok(problem)
 }
