@@ -9,7 +9,8 @@
 #   scripts/bench/side-by-side.sh 1000,10000 out.csv
 #
 # The environment variables of benches/side_by_side.rs pass through
-# (RINGMESH_SIDE_FAMILIES, RINGMESH_SIDE_REPEATS, RINGMESH_SIDE_GRADIENT).
+# (RINGMESH_SIDE_FAMILIES, RINGMESH_SIDE_REPEATS, RINGMESH_SIDE_GRADIENT,
+# RINGMESH_SIDE_NETS: network files, e.g. `ringmesh mesh`'s network.json).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 free="${1:-1000,10000}"
