@@ -195,6 +195,10 @@ enum Values {
 trait Real: faer::traits::RealField + Copy {
     fn of(x: f64) -> Self;
     fn to(self) -> f64;
+    /// `values`' storage, where it is in this type.
+    fn stored(values: Values) -> Option<Storage<Self>>;
+    /// `storage` as a factor's values.
+    fn store(storage: Storage<Self>) -> Values;
 }
 
 impl Real for f64 {
@@ -203,6 +207,15 @@ impl Real for f64 {
     }
     fn to(self) -> f64 {
         self
+    }
+    fn stored(values: Values) -> Option<Storage<Self>> {
+        match values {
+            Values::Double(storage) => Some(storage),
+            Values::Single(_) => None,
+        }
+    }
+    fn store(storage: Storage<Self>) -> Values {
+        Values::Double(storage)
     }
 }
 
@@ -213,6 +226,15 @@ impl Real for f32 {
     }
     fn to(self) -> f64 {
         f64::from(self)
+    }
+    fn stored(values: Values) -> Option<Storage<Self>> {
+        match values {
+            Values::Single(storage) => Some(storage),
+            Values::Double(_) => None,
+        }
+    }
+    fn store(storage: Storage<Self>) -> Values {
+        Values::Single(storage)
     }
 }
 
@@ -356,22 +378,8 @@ impl Condensation {
             .map(|&p| values[p].abs())
             .fold(f64::MIN_POSITIVE, f64::max);
         let (l, (l22, lambda2)) = match precision {
-            Precision::Double => {
-                let storage = match storage {
-                    Some(Values::Double(s)) => Some(s),
-                    _ => None,
-                };
-                let (l, trailing) = self.numeric(values, tau, storage)?;
-                (Values::Double(l), trailing)
-            }
-            Precision::Single => {
-                let storage = match storage {
-                    Some(Values::Single(s)) => Some(s),
-                    _ => None,
-                };
-                let (l, trailing) = self.numeric(values, tau, storage)?;
-                (Values::Single(l), trailing)
-            }
+            Precision::Double => self.numeric::<f64>(values, tau, storage)?,
+            Precision::Single => self.numeric::<f32>(values, tau, storage)?,
         };
         let s = match &self.lu {
             None => None,
@@ -397,17 +405,17 @@ impl Condensation {
         })
     }
 
-    /// `M`'s LDLᵀ at the tangent's `values` and the shift `tau` (in
-    /// `storage`, when there is one), and the factors `L₂₂`, `Λ₂` of its
-    /// trailing Schur complement.
+    /// `M`'s LDLᵀ in `T` at the tangent's `values` and the shift `tau` (in
+    /// `previous`'s storage where it is in `T`), and the factors `L₂₂`, `Λ₂`
+    /// of its trailing Schur complement.
     fn numeric<T: Real>(
         &self,
         values: &[f64],
         tau: f64,
-        storage: Option<Storage<T>>,
-    ) -> Result<(Storage<T>, Trailing), CondensedError> {
+        previous: Option<Values>,
+    ) -> Result<(Values, Trailing), CondensedError> {
         let par = self.par;
-        let mut storage = match storage {
+        let mut storage = match previous.and_then(T::stored) {
             Some(storage) => storage,
             None => Storage {
                 matrix: Vec::new(),
@@ -439,7 +447,7 @@ impl Condensation {
             self.points.len(),
             self.coupled.len(),
         );
-        Ok((storage, trailing))
+        Ok((T::store(storage), trailing))
     }
 }
 
