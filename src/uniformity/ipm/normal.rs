@@ -205,7 +205,7 @@ impl<const D: usize> NormalMatrix<D> {
     /// for the Cholesky factor `L_i` of node `i`'s diagonal block `B_i`
     /// raised by [`NODE_BLOCK_FLOOR`] of its trace (`1` for a block without
     /// weight): every node's block becomes the identity but in directions
-    /// weaker than that floor.
+    /// weaker than that floor (the plan problem, `D = 2`).
     ///
     /// A unit diagonal is not enough. Near the optimum `Θ` spans ~10^±20, and
     /// at a node whose stiff cables run one way (the sagged boundary: its
@@ -218,7 +218,12 @@ impl<const D: usize> NormalMatrix<D> {
     /// 2.2e-7 of the largest tension at the boundary — 1.6e-5 of the set's
     /// least — and ended 3.1e-6 above clarabel's optimum after 43
     /// iterations; with the node blocks scaled it ends 7e-11 from it, the
-    /// residual at 2e-11, after 26.
+    /// residual at 3e-12, after 26.
+    ///
+    /// The 3-D problem (`D = 3`) keeps the unit diagonal: its blocks hold the
+    /// net's mechanisms (dependent rows of `A`), which the factor's dynamic
+    /// regularisation drops pivot by pivot; scaled by blocks, small-hex's
+    /// full LP stalled (`ipm::tests::full_problem_matches_clarabel_small_hex`).
     ///
     /// The floor: a direction of `B_i` weaker than `ε λ_max` is rounding
     /// (its entries carry absolute errors of `ε λ_max`); scaled up to unity
@@ -238,8 +243,12 @@ impl<const D: usize> NormalMatrix<D> {
         };
         for (i, s) in self.scaling.iter_mut().enumerate() {
             let block = diagonal_block(values, i);
-            let floor = NODE_BLOCK_FLOOR * block.trace();
-            *s = inverse_cholesky(block + Block::<D>::from_diagonal_element(floor));
+            *s = if D == 2 {
+                let floor = NODE_BLOCK_FLOOR * block.trace();
+                inverse_cholesky(block + Block::<D>::from_diagonal_element(floor))
+            } else {
+                unit_diagonal(&block)
+            };
         }
         for (lo, s_lo) in self.scaling.iter().enumerate() {
             let scaled = s_lo * diagonal_block(values, lo) * s_lo.transpose();
@@ -339,6 +348,18 @@ fn inverse_cholesky<const D: usize>(block: Block<D>) -> Block<D> {
         .and_then(|c| c.l().solve_lower_triangular(&Block::<D>::identity()))
         .filter(|s| s.iter().all(|v| v.is_finite()))
         .unwrap_or_else(Block::<D>::identity)
+}
+
+/// `diag(B)^(-1/2)` (`1` where a diagonal entry is not positive): the
+/// scaling of `M` to a unit diagonal.
+fn unit_diagonal<const D: usize>(block: &Block<D>) -> Block<D> {
+    Block::<D>::from_diagonal(&block.diagonal().map(|d| {
+        if d > 0.0 && d.is_finite() {
+            1.0 / d.sqrt()
+        } else {
+            1.0
+        }
+    }))
 }
 
 #[cfg(test)]
