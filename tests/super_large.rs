@@ -163,6 +163,12 @@ fn super_60m_designs_assembles_and_keeps_its_margin() {
 /// stalled at prestrain 0 when the assembly re-solved the truss). Started
 /// from the loop's own truss equilibrium, it converges at once onto the
 /// design.
+///
+/// The loop runs to 1e-8 m, not the default 1e-6 m: the assembled tensions
+/// read where the loop stopped, a boundary within 1e-6 m being up to 0.05 %
+/// of an 80 mm cable's tension. Measured with the plan LP's node-block
+/// scaling: 0.051 % at 1e-6 m (0.00074 % with the unit diagonal, whose
+/// loop happened to stop nearer), 0.0004 % at 1e-8 m.
 #[test]
 fn a_120_bay_ring_assembles_from_the_loops_truss_equilibrium() {
     let text = std::fs::read_to_string(common::problem("super-60m.toml")).unwrap();
@@ -173,13 +179,12 @@ fn a_120_bay_ring_assembles_from_the_loops_truss_equilibrium() {
     assert_eq!((scene.truss.bays, scene.front_net.rings), (120, 20));
     let nets = SceneNets::new(&scene).unwrap();
     let solver = SolverKind::Lp.build(None);
+    let settings = LoopSettings {
+        tolerance_m: 1e-8,
+        ..LoopSettings::default()
+    };
     let outcome = nets
-        .design_loop(
-            solver.as_ref(),
-            TrussModel::Exact,
-            &LoopSettings::default(),
-            &mut |_| {},
-        )
+        .design_loop(solver.as_ref(), TrussModel::Exact, &settings, &mut |_| {})
         .unwrap();
     assert_eq!(outcome.termination, Termination::Converged);
     let equilibrium = outcome.truss_equilibrium.as_ref();
@@ -202,7 +207,7 @@ fn a_120_bay_ring_assembles_from_the_loops_truss_equilibrium() {
     assert!(v.slack_cables.is_empty(), "{:?}", v.slack_cables);
     assert!(v.rms_mm <= 1e-3, "RMS {} mm", v.rms_mm);
     assert!(
-        v.max_tension_change_pct <= 0.05,
+        v.max_tension_change_pct <= 0.01,
         "{} %",
         v.max_tension_change_pct
     );

@@ -1,9 +1,9 @@
 //! The normal system `M = A Θ̃ Aᵀ` of the reduced Newton system: its pattern,
 //! fill-reducing ordering and symbolic Cholesky factorisation (once), its
-//! numeric factorisation per iteration (scaled to unit diagonal, shifted when a
-//! pivot fails), the products with `A` and `Aᵀ`, and solves with the factor
-//! (`supernodal.rs`'s kernel on a supernodal factor) and with iterative
-//! refinement against the exact `M`.
+//! numeric factorisation per iteration (each node's diagonal block scaled to
+//! the identity, shifted when a pivot fails), the products with `A` and `Aᵀ`,
+//! and solves with the factor (`supernodal.rs`'s kernel on a supernodal
+//! factor) and with iterative refinement against the exact `M`.
 
 use std::sync::Arc;
 
@@ -38,10 +38,11 @@ pub(super) struct NormalMatrix<const D: usize> {
     /// cables' ends it was made of: shared with the LPs of neighbouring
     /// geometries of the same net ([`super::WarmStart`]).
     structure: Arc<BlockPattern>,
-    /// Values of `M`, scaled to unit diagonal.
+    /// Values of `M`, scaled to identity node blocks.
     values: Vec<f64>,
-    /// `1/√M_ii`.
-    scale: Vec<f64>,
+    /// Per free node, the scaling `S_i` of its rows and columns
+    /// ([`NormalMatrix::scale_by_node_blocks`]).
+    scaling: Vec<Block<D>>,
     factor: Vec<f64>,
     /// The factor's supernodes for the solves of
     /// [`NormalMatrix::precondition`] (`None` when faer chose a simplicial
@@ -87,7 +88,7 @@ impl<const D: usize> NormalMatrix<D> {
             u,
             values: vec![0.0; structure.col_ptr[n_rows]],
             structure,
-            scale: vec![1.0; n_rows],
+            scaling: vec![Block::<D>::identity(); n_free],
             factor,
             supernodes,
             buffer,
@@ -133,7 +134,8 @@ impl<const D: usize> NormalMatrix<D> {
         }
     }
 
-    /// Fills `M = A diag(theta) Aᵀ`, scales it to unit diagonal and factors it.
+    /// Fills `M = A diag(theta) Aᵀ`, scales its node blocks to the identity
+    /// ([`Self::scale_by_node_blocks`]) and factors it.
     pub(super) fn factorize(&mut self, theta: &[f64]) -> Result<(), NormalError> {
         let values = &mut self.values;
         values.fill(0.0);
@@ -162,21 +164,8 @@ impl<const D: usize> NormalMatrix<D> {
                 }
             }
         }
-        for (i, s) in self.scale.iter_mut().enumerate() {
-            let d = values[col_ptr[i]];
-            *s = if d > 0.0 && d.is_finite() {
-                1.0 / d.sqrt()
-            } else {
-                1.0
-            };
-        }
-        let row_idx = self.structure.pattern.row_idx();
-        for j in 0..self.n_rows {
-            let sj = self.scale[j];
-            for p in col_ptr[j]..col_ptr[j + 1] {
-                values[p] *= sj * self.scale[row_idx[p]];
-            }
-        }
+        self.scale_by_node_blocks();
+        let (values, col_ptr) = (&mut self.values, &self.structure.col_ptr);
         // The smallest shift that factors: near the optimum a pivot can lose
         // positivity to rounding; a larger shift only slows the refinement.
         let settings = &self.settings;
@@ -212,25 +201,104 @@ impl<const D: usize> NormalMatrix<D> {
         }
     }
 
-    /// `r ← M̂⁻¹ r` with the current (regularised) factor `M̂`.
+    /// Scales `M` in place to `S M Sᵀ`, `S` block diagonal with `S_i = L_i⁻¹`
+    /// for the Cholesky factor `L_i` of node `i`'s diagonal block `B_i`
+    /// raised by [`NODE_BLOCK_FLOOR`] of its trace (`1` for a block without
+    /// weight): every node's block becomes the identity but in directions
+    /// weaker than that floor (the plan problem, `D = 2`).
+    ///
+    /// A unit diagonal is not enough. Near the optimum `Θ` spans ~10^±20, and
+    /// at a node whose stiff cables run one way (the sagged boundary: its
+    /// short cables carry 90× the set's least tension at `θ ≈ 6·10¹⁸`, the
+    /// set's cables there sit at their floor) the block is stiff along the
+    /// boundary and weak across it, while its diagonal mixes the two; scaled
+    /// to a unit diagonal, the modes that only the weak directions resist sat
+    /// under the static shift, and the factor dropped them. The plan LP of
+    /// super-100m (84 242 free nodes) then stalled with a primal residual of
+    /// 2.2e-7 of the largest tension at the boundary — 1.6e-5 of the set's
+    /// least — and ended 3.1e-6 above clarabel's optimum after 43
+    /// iterations; with the node blocks scaled it ends 7e-11 from it, the
+    /// residual at 3e-12, after 26.
+    ///
+    /// The 3-D problem (`D = 3`) keeps the unit diagonal: its blocks hold the
+    /// net's mechanisms (dependent rows of `A`), which the factor's dynamic
+    /// regularisation drops pivot by pivot; scaled by blocks, small-hex's
+    /// full LP stalled (`ipm::tests::full_problem_matches_clarabel_small_hex`).
+    ///
+    /// The floor: a direction of `B_i` weaker than `ε λ_max` is rounding
+    /// (its entries carry absolute errors of `ε λ_max`); scaled up to unity
+    /// it lifts those errors above the static shift and the scaled matrix is
+    /// no longer positive definite (the six-sector grid of issue 38 at 2 431
+    /// free nodes then factored with pivots of 10⁻³⁶ and its directions
+    /// overflowed). Raised by `10⁻² tr B_i`, the errors stay below
+    /// `ε/10⁻² ≈ 10⁻¹⁴`, under the shift of 10⁻¹³.
+    fn scale_by_node_blocks(&mut self) {
+        let (values, col_ptr) = (&mut self.values, &self.structure.col_ptr);
+        let row_idx = self.structure.pattern.row_idx();
+        let diagonal_block = |values: &[f64], i: usize| {
+            Block::<D>::from_fn(|r, c| {
+                let (r, c) = (r.max(c), r.min(c));
+                values[col_ptr[D * i + c] + r - c]
+            })
+        };
+        for (i, s) in self.scaling.iter_mut().enumerate() {
+            let block = diagonal_block(values, i);
+            *s = if D == 2 {
+                let floor = NODE_BLOCK_FLOOR * block.trace();
+                inverse_cholesky(block + Block::<D>::from_diagonal_element(floor))
+            } else {
+                unit_diagonal(&block)
+            };
+        }
+        for (lo, s_lo) in self.scaling.iter().enumerate() {
+            let scaled = s_lo * diagonal_block(values, lo) * s_lo.transpose();
+            for c in 0..D {
+                for r in c..D {
+                    values[col_ptr[D * lo + c] + r - c] = scaled[(r, c)];
+                }
+            }
+            // The blocks below the diagonal, one per higher neighbour: rows
+            // `D·hi..`, after the diagonal block's `D − c` entries of column `c`.
+            let neighbours = (col_ptr[D * lo + 1] - col_ptr[D * lo] - D) / D;
+            for nb in 0..neighbours {
+                let at = |c: usize| col_ptr[D * lo + c] + (D - c) + D * nb;
+                let hi = row_idx[at(0)] / D;
+                let block = Block::<D>::from_fn(|r, c| values[at(c) + r]);
+                let scaled = self.scaling[hi] * block * s_lo.transpose();
+                for c in 0..D {
+                    for r in 0..D {
+                        values[at(c) + r] = scaled[(r, c)];
+                    }
+                }
+            }
+        }
+    }
+
+    /// `r ← M̂⁻¹ r` with the current (regularised) factor `M̂` of `S M Sᵀ`:
+    /// `M̂⁻¹ r = Sᵀ (S M Sᵀ)⁻¹ S r`.
     pub(super) fn precondition(&mut self, r: &mut [f64]) {
-        if let Some(supernodes) = &mut self.supernodes {
-            supernodes.solve_scaled(&self.factor, &self.scale, r);
-            return;
+        self.apply_scaling(r, false);
+        match &mut self.supernodes {
+            Some(supernodes) => supernodes.solve(&self.factor, r),
+            None => {
+                let n = self.n_rows;
+                LltRef::new(&self.structure.symbolic, &self.factor).solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(r, n, 1),
+                    PAR,
+                    MemStack::new(&mut self.buffer),
+                );
+            }
         }
-        for (v, s) in r.iter_mut().zip(&self.scale) {
-            *v *= s;
-        }
-        let n = self.n_rows;
-        let factor = LltRef::new(&self.structure.symbolic, &self.factor);
-        factor.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(r, n, 1),
-            PAR,
-            MemStack::new(&mut self.buffer),
-        );
-        for (v, s) in r.iter_mut().zip(&self.scale) {
-            *v *= s;
+        self.apply_scaling(r, true);
+    }
+
+    /// `r ← S r` (or `Sᵀ r`), node by node.
+    fn apply_scaling(&self, r: &mut [f64], transposed: bool) {
+        for (s, ri) in self.scaling.iter().zip(r.chunks_exact_mut(D)) {
+            let v = nalgebra::SVector::<f64, D>::from_column_slice(ri);
+            let scaled = if transposed { s.tr_mul(&v) } else { s * v };
+            ri.copy_from_slice(scaled.as_slice());
         }
     }
 
@@ -263,6 +331,35 @@ impl<const D: usize> NormalMatrix<D> {
         }
         x
     }
+}
+
+/// A D×D block of the normal matrix.
+type Block<const D: usize> = nalgebra::SMatrix<f64, D, D>;
+
+/// The floor of a node's block in [`NormalMatrix::scale_by_node_blocks`],
+/// relative to its trace.
+const NODE_BLOCK_FLOOR: f64 = 1e-2;
+
+/// `L⁻¹` for the Cholesky factor `L` of `block`, or the identity for a block
+/// that has none (a node without weight).
+fn inverse_cholesky<const D: usize>(block: Block<D>) -> Block<D> {
+    block
+        .cholesky()
+        .and_then(|c| c.l().solve_lower_triangular(&Block::<D>::identity()))
+        .filter(|s| s.iter().all(|v| v.is_finite()))
+        .unwrap_or_else(Block::<D>::identity)
+}
+
+/// `diag(B)^(-1/2)` (`1` where a diagonal entry is not positive): the
+/// scaling of `M` to a unit diagonal.
+fn unit_diagonal<const D: usize>(block: &Block<D>) -> Block<D> {
+    Block::<D>::from_diagonal(&block.diagonal().map(|d| {
+        if d > 0.0 && d.is_finite() {
+            1.0 / d.sqrt()
+        } else {
+            1.0
+        }
+    }))
 }
 
 #[cfg(test)]
@@ -304,6 +401,45 @@ mod tests {
         }
     }
 
+    /// A node held by a stiff cable one way (`θ = 10¹²`) and a slack one
+    /// across (`θ = 1`), both oblique to the axes, as the sagged boundary's
+    /// nodes near the optimum: the factor keeps the direction across, lifted
+    /// to 10⁻¹⁰ by the node block's floor (the solve 1e-3 off). Scaled to a
+    /// unit diagonal instead, that direction's eigenvalue is 2.7·10⁻¹², and
+    /// the plan's static shift of 10⁻¹³ puts its solve 3.6 % off.
+    #[test]
+    fn node_blocks_keep_the_direction_across_a_stiff_cable() {
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let (along, across) = ([c, s], [-s, c]);
+        let theta = [1e12, 1.0];
+        let lp = RatioLp {
+            n_free: 1,
+            ends: vec![[Some(0), None]; 2],
+            vectors: vec![along, across],
+            lengths: vec![1.0; 2],
+            in_set: vec![true; 2],
+            min_other_tension: 1.0,
+        };
+        let mut normal = NormalMatrix::new(&lp, &IpmSettings::plan(), None).expect("normal matrix");
+        normal.factorize(&theta).expect("factor");
+        for b in [across, along, [1.0, 0.0]] {
+            let mut x = b.to_vec();
+            normal.precondition(&mut x);
+            // M⁻¹ b = Σ_k u_k (u_kᵀ b)/θ_k for the orthonormal u_k.
+            let exact: Vec<f64> = (0..2)
+                .map(|i| {
+                    [along, across]
+                        .iter()
+                        .zip(theta)
+                        .map(|(u, t)| u[i] * (u[0] * b[0] + u[1] * b[1]) / t)
+                        .sum()
+                })
+                .collect();
+            let error = (x[0] - exact[0]).hypot(x[1] - exact[1]) / exact[0].hypot(exact[1]);
+            assert!(error <= 1e-2, "M⁻¹ b off by {error:e} for b = {b:?}");
+        }
+    }
+
     /// The solves with the factor's own supernodal kernel agree with faer's
     /// supernodal solve to rounding (they differ only in the order of the
     /// sums; measured 5·10⁻¹⁴ of the solution), with `Θ` spanning twelve
@@ -325,8 +461,12 @@ mod tests {
             .map(|i| ((i * 37 % 101) as f64 - 50.0) / 50.0)
             .collect();
         let mut own = b.clone();
-        normal.precondition(&mut own);
-        let mut reference: Vec<f64> = b.iter().zip(&normal.scale).map(|(v, s)| v * s).collect();
+        normal
+            .supernodes
+            .as_mut()
+            .expect("supernodal")
+            .solve(&normal.factor, &mut own);
+        let mut reference = b;
         let n = normal.n_rows;
         LltRef::new(&normal.structure.symbolic, &normal.factor).solve_in_place_with_conj(
             Conj::No,
@@ -334,10 +474,6 @@ mod tests {
             Par::Seq,
             MemStack::new(&mut normal.buffer),
         );
-        reference
-            .iter_mut()
-            .zip(&normal.scale)
-            .for_each(|(v, s)| *v *= s);
         let scale = norm_inf(&reference);
         let difference = own
             .iter()

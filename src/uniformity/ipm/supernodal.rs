@@ -78,31 +78,30 @@ impl Supernodes {
         })
     }
 
-    /// `r ← S (P L Lᵀ Pᵀ)⁻¹ S r` with the values `l` of the factor, `P` its
-    /// permutation and `S = diag(scale)` (the factored matrix is `S M S`).
+    /// `r ← (P L Lᵀ Pᵀ)⁻¹ r` with the values `l` of the factor and `P` its
+    /// permutation.
     ///
     /// # Panics
-    /// If `r` or `scale` is not of the factor's order, or `l` not of its
-    /// length.
-    pub(super) fn solve_scaled(&mut self, l: &[f64], scale: &[f64], r: &mut [f64]) {
-        assert!(r.len() == self.perm.len() && scale.len() == self.perm.len());
+    /// If `r` is not of the factor's order, or `l` not of its length.
+    pub(super) fn solve(&mut self, l: &[f64], r: &mut [f64]) {
+        assert!(r.len() == self.perm.len());
         assert!(self.blocks.last().is_none_or(|b| {
             let nr = b.ncols + b.rows.1 - b.rows.0;
             b.values + nr * b.ncols == l.len()
         }));
         for (xi, &p) in self.x.iter_mut().zip(&self.perm) {
-            *xi = r[p] * scale[p];
+            *xi = r[p];
         }
-        self.solve(l);
+        self.sweep(l);
         for (xi, &p) in self.x.iter().zip(&self.perm) {
-            r[p] = xi * scale[p];
+            r[p] = *xi;
         }
     }
 
     /// `x ← L⁻ᵀ L⁻¹ x` in elimination order: per supernode the dense
     /// triangle, then one update of its pattern rows, gathered in a
     /// contiguous buffer.
-    fn solve(&mut self, l: &[f64]) {
+    fn sweep(&mut self, l: &[f64]) {
         let x = &mut self.x;
         let gathered = &mut self.gathered;
         for b in &self.blocks {
