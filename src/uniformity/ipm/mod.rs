@@ -28,9 +28,9 @@
 //! D×D blocks: its pattern, fill-reducing ordering (AMD or nested dissection on
 //! the node graph, whichever fills less, expanded blockwise) and symbolic
 //! Cholesky factorisation are built once; every iteration refills the values,
-//! scales `M` so that each node's D×D diagonal block is the identity, and
-//! refactors numerically; the solves with the
-//! supernodal factor run in `supernodal.rs`'s kernel. Dependent rows of `A`
+//! scales `M` (the plan problem's node blocks to the identity, the 3-D
+//! problem's diagonal to unity) and refactors numerically; the solves with
+//! the supernodal factor run in `supernodal.rs`'s kernel. Dependent rows of `A`
 //! (mechanisms of the net) show up as (near-)zero pivots, which faer's dynamic
 //! regularisation replaces by a huge pivot, i.e. the direction is dropped. The
 //! border is eliminated with the same factor (`t = M̂⁻¹ a` once per

@@ -1,7 +1,7 @@
 //! The normal system `M = A Θ̃ Aᵀ` of the reduced Newton system: its pattern,
 //! fill-reducing ordering and symbolic Cholesky factorisation (once), its
-//! numeric factorisation per iteration (each node's diagonal block scaled to
-//! the identity, shifted when a pivot fails), the products with `A` and `Aᵀ`,
+//! numeric factorisation per iteration (scaled by node, shifted when a pivot
+//! fails), the products with `A` and `Aᵀ`,
 //! and solves with the factor (`supernodal.rs`'s kernel on a supernodal
 //! factor) and with iterative refinement against the exact `M`.
 
@@ -38,7 +38,7 @@ pub(super) struct NormalMatrix<const D: usize> {
     /// cables' ends it was made of: shared with the LPs of neighbouring
     /// geometries of the same net ([`super::WarmStart`]).
     structure: Arc<BlockPattern>,
-    /// Values of `M`, scaled to identity node blocks.
+    /// Values of `M`, scaled by node.
     values: Vec<f64>,
     /// Per free node, the scaling `S_i` of its rows and columns
     /// ([`NormalMatrix::scale_by_node_blocks`]).
@@ -134,7 +134,7 @@ impl<const D: usize> NormalMatrix<D> {
         }
     }
 
-    /// Fills `M = A diag(theta) Aᵀ`, scales its node blocks to the identity
+    /// Fills `M = A diag(theta) Aᵀ`, scales it by node
     /// ([`Self::scale_by_node_blocks`]) and factors it.
     pub(super) fn factorize(&mut self, theta: &[f64]) -> Result<(), NormalError> {
         let values = &mut self.values;

@@ -96,9 +96,9 @@ pub(crate) struct IpmSettings {
     /// quasi-definite matrix of the finish). Above 1 it drops the direction
     /// (dependent rows of the 3-D LP's `A`).
     pub pivot_delta: f64,
-    /// Static shift of the unit diagonal of the scaled Newton matrix (the
-    /// LP's: identity node blocks) before
-    /// it is factored. Cable nets are mechanisms (`A` has dependent rows: the
+    /// Static shift of the diagonal of the scaled Newton matrix (a unit
+    /// diagonal; the plan LP's node blocks scaled to the identity) before it
+    /// is factored. Cable nets are mechanisms (`A` has dependent rows: the
     /// infinitesimal mechanisms a prestress stiffens), so the LP's `M` is
     /// singular; the shift makes the factor well defined, and iterative
     /// refinement against the exact matrix removes its effect on the range,
