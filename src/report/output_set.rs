@@ -45,7 +45,7 @@ use std::fs::{self, File};
 use std::io;
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
-use std::time::{SystemTime, UNIX_EPOCH};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
 
@@ -117,6 +117,10 @@ pub struct OutputSet {
     created: bool,
 }
 
+/// Times [`OutputSet::begin`] looks again for a folder that a set swapping
+/// a folder above it took away for a moment (1 ms apart).
+const SWAP_RETRIES: usize = 1000;
+
 impl OutputSet {
     /// Prepares a set of the files `names` in the folder `dir` (created if
     /// needed), swapped in as one: checks the names and the permission,
@@ -146,6 +150,28 @@ impl OutputSet {
         for name in names {
             check_name(name)?;
         }
+        // Until `prepare_once` holds the locks above `dir`, a set swapping a
+        // folder above it can take that folder away for a moment (between
+        // its two renames, `X/sub` is not there): a missing folder is looked
+        // for again. Without this, `begin("X/sub")` beside a set swapping
+        // `X` failed about once in twenty runs of
+        // `sets_into_a_folder_and_a_folder_in_it_never_take_each_others_files`
+        // on a loaded machine.
+        let mut attempts = 0;
+        loop {
+            match Self::prepare_once(dir, names, beside) {
+                Err(ReportError::Unwritable { ref source, .. })
+                    if source.kind() == io::ErrorKind::NotFound && attempts < SWAP_RETRIES =>
+                {
+                    attempts += 1;
+                    std::thread::sleep(Duration::from_millis(1));
+                }
+                prepared => return prepared,
+            }
+        }
+    }
+
+    fn prepare_once(dir: &Path, names: &[&str], beside: bool) -> Result<OutputSet, ReportError> {
         check_writable(dir).map_err(unwritable_at(dir))?;
         // Created by this run only if this run's `mkdir` made it: two runs
         // starting together both find it missing, and one of them creates it.
