@@ -154,11 +154,13 @@ impl Program {
     /// the rows it solves only up to the factor's regularisation. FGMRES
     /// takes at most `steps` steps and stops at
     /// [`IpmSettings::krylov_tolerance`] of those rows' right-hand side or at
-    /// `floor`, whichever is larger (an absolute 2-norm); returns the
+    /// `floor`, whichever is larger (an absolute 2-norm), or when it
+    /// stagnates ([`IpmSettings::krylov_stagnation`]); returns the
     /// direction and the 2-norm of its residual in those rows (0 where the
     /// reduction is taken as it is: `steps` 0, or the 3-D problem).
     ///
     /// [`IpmSettings::krylov_tolerance`]: super::settings::IpmSettings::krylov_tolerance
+    /// [`IpmSettings::krylov_stagnation`]: super::settings::IpmSettings::krylov_stagnation
     #[allow(clippy::too_many_arguments)]
     pub(super) fn direction<const D: usize>(
         &self,
@@ -210,6 +212,8 @@ impl Program {
         let mut g = vec![beta];
         let mut residual = beta;
         let mut rw = vec![0.0; p];
+        // The residual before each step: `β`, then after steps 0, 1, …
+        let mut residuals = vec![beta];
         for it in 0..steps {
             let v = &basis[it];
             rw.iter_mut().zip(&v[n..n + p]).for_each(|(a, b)| *a = -b);
@@ -262,6 +266,11 @@ impl Program {
             let res = g[it + 1].abs();
             residual = res;
             if res <= tolerance || wn == 0.0 || !res.is_finite() {
+                break;
+            }
+            // Stagnated: two steps lowered the residual too little.
+            residuals.push(res);
+            if it >= 2 && res > self.settings.krylov_stagnation * residuals[it - 1] {
                 break;
             }
             wv.iter_mut().for_each(|a| *a /= wn);
