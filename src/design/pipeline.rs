@@ -16,6 +16,7 @@ use super::scene_nets::{default_solver, SceneNets};
 use super::summary::LoopSummary;
 use super::tied_nets::TiedNetSettings;
 use super::DesignError;
+use crate::effects::SceneEffects;
 use crate::geometry::ReflectorMesh;
 use crate::mechanics::LimitSearch;
 use crate::network::Network;
@@ -78,7 +79,8 @@ pub struct LoopRun {
 }
 
 /// Where a design run's wall time goes, s: every stage once, so that the
-/// stages add up to `total_s` (up to the writing of `design.json` itself).
+/// stages, less the time two of them ran side by side (`beside_s`), add up
+/// to `total_s` (up to the writing of `design.json` itself).
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Timings {
     /// Reading the scene (and the tables it names).
@@ -96,7 +98,8 @@ pub struct Timings {
     pub loop_other_s: f64,
     /// The other relaxations' loops, run for comparison.
     pub comparison_loops_s: f64,
-    /// The truss's limit margin under the design's pull.
+    /// The truss's limit margin under the design's pull (on a second core,
+    /// beside the stages after it).
     pub margin_s: f64,
     /// The design cut to length and assembled.
     pub verification_s: f64,
@@ -106,6 +109,10 @@ pub struct Timings {
     pub conventional_s: f64,
     /// Writing every file but `design.json`.
     pub writing_s: f64,
+    /// The wall time the margin ran beside the verification, the surface
+    /// budget and the conventional design: counted in two stages above, and
+    /// once in [`Timings::stages_s`].
+    pub beside_s: f64,
     /// Wall time from reading the scene to writing `design.json`.
     pub total_s: f64,
 }
@@ -144,6 +151,7 @@ impl Timings {
             + self.surface_s
             + self.conventional_s
             + self.writing_s
+            - self.beside_s
     }
 }
 
@@ -344,13 +352,111 @@ pub fn run_observed(
     // The flexible truss's frame, constructed once for the loop's oracle,
     // the margin and both assemblies.
     let frame = outcome.truss_deforms.then(|| scene_nets.truss_frame());
+    // The margin needs only the truss and the design: it runs on a second
+    // core beside the verification, the surface budget and the conventional
+    // design (which follow one another), and its error, the first stage's,
+    // is the one returned.
+    let after_loop = Instant::now();
     observer.stage(DesignStage::Margin);
-    let stage = Instant::now();
-    let limit_margin = match frame {
-        None => None,
-        Some(frame) => Some(design_margin(frame, &outcome.design)?),
+    let (margin, later) = std::thread::scope(|scope| {
+        let margin = scope.spawn(|| {
+            let stage = Instant::now();
+            let margin = frame
+                .map(|frame| design_margin(frame, &outcome.design))
+                .transpose();
+            (margin, stage.elapsed().as_secs_f64())
+        });
+        let later = later_stages(
+            scene,
+            mesh,
+            effects,
+            &outcome,
+            frame,
+            observer,
+            &mut timings,
+        );
+        let margin = margin
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (margin, later)
+    });
+    let (limit_margin, margin_s) = margin;
+    let limit_margin = limit_margin?;
+    let Later {
+        network,
+        sets,
+        verification,
+        surface,
+        conventional_assembly,
+        assembled,
+    } = later?;
+    timings.margin_s = margin_s;
+    timings.beside_s =
+        (margin_s + timings.verification_s + timings.surface_s + timings.conventional_s
+            - after_loop.elapsed().as_secs_f64())
+        .max(0.0);
+    let conventional = conventional_assembly
+        .as_ref()
+        .map(|(_, a)| a.verification.clone());
+    let conventional_net = conventional_assembly
+        .as_ref()
+        .map(|_| outcome.initial.design.clone());
+    let report = DesignReport {
+        scene: scene.name.clone(),
+        solver: solver.name().to_string(),
+        truss: model,
+        relaxation: relaxations[0],
+        termination: outcome.termination,
+        outer_iterations: outcome.history.len(),
+        boundary_residual_m: outcome.boundary_residual_m(),
+        tolerance_m: settings.tolerance_m,
+        ratio: outcome.design.ratio,
+        time_s: clock.elapsed().as_secs_f64(),
+        history: outcome.history.clone(),
+        runs,
+        verification,
+        surface,
+        conventional,
+        limit_margin,
+        boundary_m: outcome.boundary_m.clone(),
+        net: outcome.design,
+        timings,
     };
-    timings.margin_s = stage.elapsed().as_secs_f64();
+    Ok(DesignRun {
+        report,
+        mesh: scene_nets.mesh,
+        network,
+        conventional_net,
+        sets,
+        assembled,
+        conventional_assembly,
+    })
+}
+
+/// What the stages after the margin make: the design's network and sets, its
+/// verification by assembly, the surface budget, the conventional design's
+/// assembly, and the design's own assembly when the truss deforms.
+struct Later {
+    network: Network,
+    sets: Vec<UniformitySet>,
+    verification: Verification,
+    surface: SurfaceBudget,
+    conventional_assembly: Option<(Network, Assembled)>,
+    assembled: Option<Assembled>,
+}
+
+/// The stages after the loop that follow one another — the verification,
+/// the surface budget and the conventional design — each timed in
+/// `timings` and announced to `observer` as it begins.
+fn later_stages(
+    scene: &Scene,
+    mesh: &ReflectorMesh,
+    effects: &SceneEffects,
+    outcome: &LoopOutcome,
+    frame: Option<&RingTrussBuilder>,
+    observer: &mut dyn DesignObserver,
+    timings: &mut Timings,
+) -> Result<Later, DesignError> {
     observer.stage(DesignStage::Verification);
     let stage = Instant::now();
     let network = outcome.problem.network().clone();
@@ -417,43 +523,15 @@ pub fn run_observed(
             Some((network.clone(), conventional))
         }
     };
-    let conventional = conventional_assembly
-        .as_ref()
-        .map(|(_, a)| a.verification.clone());
-    let conventional_net = conventional_assembly
-        .as_ref()
-        .map(|_| outcome.initial.design.clone());
     let assembled = frame.map(|_| assembled);
     timings.conventional_s = stage.elapsed().as_secs_f64();
-    let report = DesignReport {
-        scene: scene.name.clone(),
-        solver: solver.name().to_string(),
-        truss: model,
-        relaxation: relaxations[0],
-        termination: outcome.termination,
-        outer_iterations: outcome.history.len(),
-        boundary_residual_m: outcome.boundary_residual_m(),
-        tolerance_m: settings.tolerance_m,
-        ratio: outcome.design.ratio,
-        time_s: clock.elapsed().as_secs_f64(),
-        history: outcome.history.clone(),
-        runs,
+    Ok(Later {
+        network,
+        sets,
         verification,
         surface,
-        conventional,
-        limit_margin,
-        boundary_m: outcome.boundary_m.clone(),
-        net: outcome.design,
-        timings,
-    };
-    Ok(DesignRun {
-        report,
-        mesh: scene_nets.mesh,
-        network,
-        conventional_net,
-        sets,
-        assembled,
         conventional_assembly,
+        assembled,
     })
 }
 

@@ -85,8 +85,8 @@ impl DesignOutcome {
         say!(
             s,
             "time: {:.2} s — mesh {:.2}, loop {:.2} (uniformity {:.2}, truss {:.2}), \
-             comparison loops {:.2}, margin {:.2}, verification {:.2}, conventional {:.2}, \
-             writing {:.2}",
+             comparison loops {:.2}, margin {:.2} (beside the next two), verification {:.2}, \
+             conventional {:.2}, writing {:.2}",
             t.total_s,
             t.mesh_s,
             t.design_loop_s(),
