@@ -271,7 +271,9 @@ fn every_relaxation_converges_and_anderson_needs_the_fewest_iterations() {
 }
 
 /// `design.json` says where the time went: one entry per stage, the loop's
-/// per iteration, adding up to the command's wall time within 5 %.
+/// per iteration, adding up (less the margin's time beside the later
+/// stages) to its `total_s` within 5 %, which is the command's wall time but
+/// for writing `design.json` and publishing the files.
 #[test]
 fn the_timings_of_a_design_run_add_up_to_its_wall_time() {
     let out = tempfile::tempdir().unwrap();
@@ -311,11 +313,27 @@ fn the_timings_of_a_design_run_add_up_to_its_wall_time() {
         "{t:?}"
     );
     assert!(t.comparison_loops_s > 0.0 && t.verification_s > 0.0 && t.writing_s > 0.0);
+    // The margin ran beside the three stages after it: for no longer than
+    // the shorter side.
+    let later = t.verification_s + t.surface_s + t.conventional_s;
+    assert!(
+        t.beside_s >= 0.0 && t.beside_s <= t.margin_s.min(later) + 1e-3,
+        "{t:?}"
+    );
     assert!(t.total_s <= wall, "{} s of {wall} s", t.total_s);
     assert!(
-        (t.stages_s() - wall).abs() <= 0.05 * wall,
-        "stages {} s, wall {wall} s: {t:?}",
-        t.stages_s()
+        (t.stages_s() - t.total_s).abs() <= 0.05 * t.total_s,
+        "stages {} s, total {} s: {t:?}",
+        t.stages_s(),
+        t.total_s
+    );
+    // What `total_s` leaves out is writing `design.json` and publishing the
+    // output set (synced writes and renames: 15 ms of this 0.23 s run under
+    // the suite's load).
+    assert!(
+        wall - t.total_s <= 0.05 * wall + 0.05,
+        "total {} s, wall {wall} s",
+        t.total_s
     );
     let written: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.path().join("design.json")).unwrap()).unwrap();
