@@ -128,6 +128,13 @@ fn settings_out_of_range_are_named() {
             },
             "min_centring",
         ),
+        (
+            IpmSettings {
+                krylov_stagnation: 1.0,
+                ..IpmSettings::default()
+            },
+            "krylov_stagnation",
+        ),
     ] {
         match solve(&full_lp(&problem), &settings, None) {
             Err(IpmError::Setting { name: found, .. }) => assert_eq!(found, name),
