@@ -154,9 +154,9 @@ impl OutputSet {
         // folder above it can take that folder away for a moment (between
         // its two renames, `X/sub` is not there): a missing folder is looked
         // for again. Without this, `begin("X/sub")` beside a set swapping
-        // `X` failed about once in twenty runs of
+        // `X` failed with `NotFound` in
         // `sets_into_a_folder_and_a_folder_in_it_never_take_each_others_files`
-        // on a loaded machine.
+        // (once, in a full test run on a loaded machine).
         let mut attempts = 0;
         loop {
             match Self::prepare_once(dir, names, beside) {

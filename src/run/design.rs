@@ -395,8 +395,8 @@ fn write_design(
     // the pictures and `cables.csv` beside `model.vtu` and the convergence
     // table (25 and 33 MB of text at 84 362 nodes).
     let r: &DesignReport = report;
-    let (pictures, files) = std::thread::scope(|scope| {
-        let pictures = scope.spawn(|| -> Result<(), Error> {
+    let (pictures, files) = rayon::join(
+        || -> Result<(), Error> {
             convergence_plot(
                 &series,
                 &format!("{}: outer design loop", scene.name),
@@ -413,8 +413,8 @@ fn write_design(
                 cables_csv(network, &r.net, &scene.cables).as_bytes(),
             )?;
             Ok(())
-        });
-        let files = (|| -> Result<(), Error> {
+        },
+        || -> Result<(), Error> {
             write_atomic(
                 &path("model.vtu"),
                 assembly_vtu(
@@ -432,12 +432,8 @@ fn write_design(
                 convergence_csv(&r.runs).as_bytes(),
             )?;
             Ok(())
-        })();
-        let pictures = pictures
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (pictures, files)
-    });
+        },
+    );
     pictures?;
     files?;
     let run = set.seal()?;
